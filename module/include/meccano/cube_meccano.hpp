@@ -1,0 +1,24 @@
+// The cube meccano: a box cut into nx × ny × nz equal cells, each cell into the 6 Kuhn tets around its
+// main diagonal, refined uniformly.
+//
+// Input   a box (min < max on every axis), optionally the cell counts, and a uniform level K.
+// Output  a conforming TetMesh with 6 · 2^K tets per cell. Each Kuhn tet with path vertices
+//         p0 = corner, p1 = p0 + e_a, p2 = p1 + e_b, p3 = opposite corner is stored as (p0, p3, p2, p1),
+//         type 0: the refinement edge is the cell diagonal, and this order is the one under which
+//         Kossaczky bisection produces exactly 3 similarity classes (notes §1.3). The Kuhn split is
+//         translation invariant, so neighbouring cells conform. Boundary faces carry their box-side tag.
+// Errors  InputError for an empty or inverted box, non-positive cell counts, or a negative level.
+#pragma once
+
+#include <meccano/tet_mesh.hpp>
+
+namespace meccano {
+
+// Cell counts for equal cells as close to cubes as possible: the cell edge is the box's shortest
+// extent and each count is the nearest integer to extent / cell edge (a 2×1×1 box gives 2, 1, 1).
+std::array<int, 3> cells_for_box(const Box& box);
+
+TetMesh make_cube_meccano(const Box& box, const std::array<int, 3>& cells, int level = 0);
+TetMesh make_cube_meccano(const Box& box, int level = 0);
+
+}  // namespace meccano

@@ -1,0 +1,101 @@
+#include <meccano/cube_meccano.hpp>
+
+#include <meccano/bisection.hpp>
+#include <meccano/error.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace meccano {
+namespace {
+
+void check_box(const Box& box) {
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(box.min[k]) || !std::isfinite(box.max[k]) || !(box.min[k] < box.max[k])) {
+      std::ostringstream message;
+      message << "invalid box: on axis " << "xyz"[k] << " the lower bound " << box.min[k]
+              << " is not below the upper bound " << box.max[k];
+      throw InputError(message.str());
+    }
+}
+
+// Tags every face without a neighbour by the box side its vertices lie on.
+void tag_box_sides(TetMesh& mesh) {
+  const GridPoint upper = mesh.meccano.upper_corner();
+  for (TetId t = 0; t < mesh.num_tets(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      if (mesh.neighbours[t][f] != no_tet) continue;
+      for (int axis = 0; axis < 3; ++axis)
+        for (int upper_side = 0; upper_side < 2; ++upper_side) {
+          const std::int64_t plane = upper_side ? upper[axis] : 0;
+          const bool on_plane = std::all_of(face_vertices[f].begin(), face_vertices[f].end(), [&](int local) {
+            return mesh.grid[mesh.tets[t][local]][axis] == plane;
+          });
+          if (on_plane) mesh.face_tags[t][f] = box_side_tag(static_cast<BoxSide>(2 * axis + upper_side));
+        }
+    }
+}
+
+}  // namespace
+
+std::array<int, 3> cells_for_box(const Box& box) {
+  check_box(box);
+  const Eigen::Vector3d extent = box.extent();
+  const double edge = extent.minCoeff();
+  std::array<int, 3> cells{};
+  for (int k = 0; k < 3; ++k) cells[k] = std::max(1, static_cast<int>(std::lround(extent[k] / edge)));
+  return cells;
+}
+
+TetMesh make_cube_meccano(const Box& box, const std::array<int, 3>& cells, int level) {
+  check_box(box);
+  for (int k = 0; k < 3; ++k)
+    if (cells[k] < 1 || cells[k] > 1024)
+      throw InputError("invalid cell count " + std::to_string(cells[k]) + " on axis " + "xyz"[k] +
+                       " (allowed: 1 to 1024)");
+  if (level < 0) throw InputError("invalid level " + std::to_string(level) + " (must be 0 or more)");
+
+  TetMesh mesh;
+  mesh.meccano.box = box;
+  mesh.meccano.cells = cells;
+  for (int k = 0; k < 3; ++k) mesh.meccano.cell_size[k] = box.extent()[k] / cells[k];
+
+  const int nx = cells[0] + 1, ny = cells[1] + 1, nz = cells[2] + 1;
+  auto node = [&](int i, int j, int k) { return static_cast<VertexId>(i + nx * (j + ny * k)); };
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const GridPoint g{i * grid_cell, j * grid_cell, k * grid_cell};
+        mesh.add_vertex(mesh.meccano.to_physical(g), g);
+      }
+
+  static constexpr std::array<std::array<int, 3>, 6> axis_orders{
+      {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
+  const std::size_t num_cells = static_cast<std::size_t>(cells[0]) * cells[1] * cells[2];
+  mesh.reserve_tets(6 * num_cells << level);
+  for (int k = 0; k < cells[2]; ++k)
+    for (int j = 0; j < cells[1]; ++j)
+      for (int i = 0; i < cells[0]; ++i)
+        for (const auto& order : axis_orders) {
+          std::array<int, 3> step{0, 0, 0};
+          std::array<VertexId, 4> path{};
+          path[0] = node(i, j, k);
+          for (int s = 0; s < 3; ++s) {
+            step[order[s]] = 1;
+            path[s + 1] = node(i + step[0], j + step[1], k + step[2]);
+          }
+          mesh.tets.push_back({path[0], path[3], path[2], path[1]});
+          mesh.kinds.push_back(TetKind::make(0, false));
+          mesh.face_tags.push_back({no_face_tag, no_face_tag, no_face_tag, no_face_tag});
+          mesh.kinds.back() = TetKind::make(0, grid_orientation(mesh, mesh.num_tets() - 1) < 0);
+        }
+  build_neighbours(mesh);
+  tag_box_sides(mesh);
+  refine_uniformly(mesh, level);
+  return mesh;
+}
+
+TetMesh make_cube_meccano(const Box& box, int level) { return make_cube_meccano(box, cells_for_box(box), level); }
+
+}  // namespace meccano

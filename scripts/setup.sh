@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs every Debian package meccano-immerse needs to build, test and run its demos.
+# Idempotent; needs root (or sudo) on a Debian 12 machine.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libeigen3-dev                       # the module's only library dependency (with OpenMP)
+  libgtest-dev libbenchmark-dev       # tests and benchmarks
+  libgmsh-dev gmsh                    # independent MSH reader in the tests, reference meshes
+  python3 python3-matplotlib python3-numpy   # plots in doc/
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
+echo "setup: installing ${missing[*]}"
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

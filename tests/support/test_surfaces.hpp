@@ -1,0 +1,51 @@
+// Generators of immersed test surfaces.
+//
+// Every generator returns a regular triangulation of an open topological disk with consistent
+// orientation (normals by the right-hand rule), `name` set and `source` empty, lying well inside the
+// unit cube [0,1]^3 (at least 0.1 from its faces). n is the resolution: cells per side of a grid patch,
+// rings of the spherical cap; triangle counts grow like n^2.
+#pragma once
+
+#include <meccano/box.hpp>
+#include <meccano/surface.hpp>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace meccano::testing {
+
+// z = f(x, y) over x_range x y_range, n x n cells, two triangles per cell, normals towards +z.
+TriangleSurface graph_patch(const std::function<double(double, double)>& f, std::array<double, 2> x_range,
+                            std::array<double, 2> y_range, int n, std::string name = "graph");
+
+TriangleSurface tilted_plane(int n);           // z = 0.35 + 0.3 x + 0.1 y over [0.1, 0.9]^2
+TriangleSurface near_vertical_patch(int n);    // x ~ 0.5 + small bump, within 5 degrees of the plane x = 0.5
+TriangleSurface saddle(int n);                 // z = 0.5 + 1.2 (x - 0.5)(y - 0.5) over [0.1, 0.9]^2
+TriangleSurface spherical_cap(int n);          // radius 0.4, polar angle 65 degrees, circular rim, n rings
+TriangleSurface strongly_curved_sheet(int n);  // 220-degree sector of a cylinder of radius 0.3 (axis y)
+std::vector<TriangleSurface> stacked_pair(int n);  // two parallel bumps, 0.3 apart in z
+// The paper-like patch of shared/notes/peers.md section 6: over (x, y) in [0.2, 0.8]^2,
+// z = 0.42 + 0.12 u v + 0.10 sin(pi u) sin(pi v), u = (x - 0.2) / 0.6, v = (y - 0.2) / 0.6.
+TriangleSurface paper_like_patch(int n);
+
+struct NamedSurfaces {
+  std::string name;
+  std::vector<TriangleSurface> surfaces;
+};
+
+// All of the above (the stacked pair as one entry with two surfaces), plus a perturbed paper-like
+// patch (irregular triangles).
+std::vector<NamedSurfaces> named_test_surfaces(int n);
+
+// Moves every vertex not on the rim by a random tangential offset of length at most amplitude times
+// the shortest edge at that vertex (deterministic for a seed on every platform). amplitude <= 0.25
+// keeps every triangle valid.
+TriangleSurface perturbed(TriangleSurface surface, double amplitude, std::uint64_t seed);
+
+// Maps the unit cube onto `box` (affinely, per axis).
+TriangleSurface scaled_into(TriangleSurface surface, const Box& box);
+
+}  // namespace meccano::testing

@@ -5,7 +5,11 @@
 #include <meccano/error.hpp>
 #include <meccano/mesh_check.hpp>
 #include <meccano/mesh_io.hpp>
+#include <meccano/pipeline.hpp>
+#include <meccano/surface.hpp>
+#include <meccano/surface_validation.hpp>
 
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -22,21 +26,29 @@ namespace {
 
 constexpr const char* usage_text = R"(Usage: meccano-immerse --box X0,Y0,Z0,X1,Y1,Z1 [options] --output FILE.msh
 
-Builds the meccano tetrahedral mesh of a box: equal cells as close to cubes as possible, 6 Kuhn tets
-per cell, refined uniformly by Kossaczky bisection.
+Builds the meccano tetrahedral mesh of a box (equal cells as close to cubes as possible, 6 Kuhn tets
+per cell, refined uniformly by Kossaczky bisection) and inserts immersed surfaces into it.
 
 Options:
   --box X0,Y0,Z0,X1,Y1,Z1  the box (required)
   --cells NX,NY,NZ         cell counts (default: equal cells as close to cubes as possible)
   --level K                uniform bisection levels: 6·2^K tets per cell (default 0)
-  --output FILE.msh        Gmsh MSH 4.1 ASCII with the 3D group `domain` and the 2D groups
-                           xmin, xmax, ymin, ymax, zmin, zmax (may repeat)
+  --surface FILE[:NAME]    an open triangulated surface strictly inside the box (.obj, .stl, .off,
+                           .msh); NAME defaults to its 1-based position (may repeat)
+  --resolution L           l_r: tets meeting a surface are refined until their longest edge is below L
+                           (required with --surface)
+  --stage volumetric       stop after this stage and write its result: the refined mesh with the 3D
+                           group volumetric_NAME holding each surface's volumetric approximation
+  --output FILE.msh        Gmsh MSH 4.1 ASCII with the 3D group `domain`, the 2D groups xmin, xmax,
+                           ymin, ymax, zmin, zmax, and the groups of the stage (may repeat)
   --quiet                  no progress output
   --help                   this text
 
 Examples:
   meccano-immerse --box 0,0,0,1,1,1 --level 9 --output cube.msh
   meccano-immerse --box 0,0,0,2,1,1 --level 6 --output bar.msh      (two unit cells)
+  meccano-immerse --box 0,0,0,1,1,1 --surface patch.obj:fault --resolution 0.03 \
+                  --stage volumetric --output fault_vm.msh
 )";
 
 struct UsageError : std::runtime_error {
@@ -49,8 +61,25 @@ struct Options {
   std::optional<std::array<int, 3>> cells;
   int level = 0;
   std::vector<std::string> outputs;
+  std::vector<std::pair<std::string, std::string>> surfaces;  // file, name
+  std::optional<double> resolution;
+  std::optional<std::string> stage;
   bool quiet = false;
 };
+
+// FILE[:NAME]; a colon followed by a path separator belongs to the file name.
+std::pair<std::string, std::string> parse_surface(const std::string& text, std::size_t position) {
+  const auto colon = text.rfind(':');
+  if (colon != std::string::npos && colon > 0 && text.find('/', colon) == std::string::npos) {
+    const std::string name = text.substr(colon + 1);
+    if (name.empty()) throw UsageError("--surface " + text + ": empty name after ':'");
+    for (char c : name)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-')
+        throw UsageError("--surface " + text + ": a name may hold letters, digits, '_' and '-' only");
+    return {text.substr(0, colon), name};
+  }
+  return {text, std::to_string(position)};
+}
 
 std::vector<double> parse_numbers(const std::string& option, const std::string& text, std::size_t count) {
   std::vector<double> values;
@@ -112,6 +141,16 @@ Options parse_options(int argc, char** argv) {
     } else if (arg == "--level") {
       options.level = parse_int(arg, value());
       if (options.level < 0 || options.level > 40) throw UsageError("--level must be between 0 and 40");
+    } else if (arg == "--surface") {
+      options.surfaces.push_back(parse_surface(value(), options.surfaces.size() + 1));
+    } else if (arg == "--resolution") {
+      const double l = parse_numbers(arg, value(), 1)[0];
+      if (!(l > 0)) throw UsageError("--resolution must be positive");
+      options.resolution = l;
+    } else if (arg == "--stage") {
+      options.stage = value();
+      if (*options.stage != "volumetric")
+        throw UsageError("--stage " + *options.stage + ": the stages available are: volumetric");
     } else if (arg == "--output" || arg == "-o") {
       options.outputs.push_back(value());
     } else if (arg == "--quiet" || arg == "-q") {
@@ -122,6 +161,15 @@ Options parse_options(int argc, char** argv) {
   }
   if (!options.box_given) throw UsageError("--box is required");
   if (options.outputs.empty()) throw UsageError("--output is required");
+  if (!options.surfaces.empty() && !options.resolution) throw UsageError("--surface needs --resolution");
+  if (options.surfaces.empty() && (options.resolution || options.stage))
+    throw UsageError("--resolution and --stage need at least one --surface");
+  if (!options.surfaces.empty() && !options.stage)
+    throw UsageError("only --stage volumetric is available so far: give it explicitly");
+  for (std::size_t i = 0; i < options.surfaces.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (options.surfaces[i].second == options.surfaces[j].second)
+        throw UsageError("two surfaces are named " + options.surfaces[i].second);
   for (const auto& output : options.outputs)
     if (output.size() < 4 || output.substr(output.size() - 4) != ".msh")
       throw UsageError("--output " + output + ": only .msh output is supported");
@@ -153,16 +201,32 @@ int run(const Options& options) {
   const std::int64_t expected_tets = (std::int64_t{6} * cells[0] * cells[1] * cells[2]) << options.level;
   progress.say("meccano: ", cells[0], "x", cells[1], "x", cells[2], " cells, level ", options.level, ", ",
                expected_tets, " tets");
-  const meccano::TetMesh mesh = meccano::make_cube_meccano(options.box, cells, options.level);
+  // Read and validate every surface before any meshing: bad input must not cost a meshing run.
+  std::vector<meccano::TriangleSurface> surfaces;
+  for (const auto& [file, name] : options.surfaces) {
+    surfaces.push_back(meccano::read_surface(file));
+    surfaces.back().name = name;
+    progress.say("surface ", name, ": ", file, ", ", surfaces.back().triangles.size(), " triangles, ",
+                 surfaces.back().points.size(), " points");
+  }
+  meccano::validate_surfaces(surfaces, options.box);
+  if (!surfaces.empty()) progress.say("surfaces valid: open disks, inside the box, disjoint");
+
+  meccano::TetMesh mesh = meccano::make_cube_meccano(options.box, cells, options.level);
   progress.say("meccano: ", mesh.num_tets(), " tets, ", mesh.num_vertices(), " nodes");
 
-  const auto check = meccano::verify_mesh(mesh);
+  meccano::InsertionOptions insertion;
+  insertion.resolution = options.resolution.value_or(0.0);
+  insertion.progress = [&progress](const std::string& line) { progress.say(line); };
+  const meccano::InsertionResult result = meccano::insert_surfaces(std::move(mesh), surfaces, insertion);
+
+  const auto check = meccano::verify_mesh(result.mesh);
   if (!check.ok()) throw meccano::MeshingError("the mesh fails its invariant checks: " + check.summary());
 
-  const auto groups = meccano::standard_groups(mesh);
+  const auto groups = meccano::output_groups(result);
   for (const auto& output : options.outputs) {
-    meccano::write_msh41(mesh, groups, output);
-    progress.say("wrote ", output);
+    meccano::write_msh41(result.mesh, groups, output);
+    progress.say("wrote ", output, ": ", result.mesh.num_tets(), " tets, ", result.mesh.num_vertices(), " nodes");
   }
   return 0;
 }

@@ -60,40 +60,42 @@ void print(const Row& row) {
   std::fflush(stdout);
 }
 
-// Uniform refinement from the level-3 mesh to `level` (the timed part excludes building the start).
-Row uniform(int level, int repeat) {
+// Runs `refine` on the level-3 unit-cube mesh `repeat` times; the timed part excludes building it.
+template <class Refine>
+Row measure(std::string what, int repeat, Refine refine) {
   Row row;
-  row.what = "uniform, unit cube, level 3 -> " + std::to_string(level);
+  row.what = std::move(what);
   for (int r = 0; r < repeat; ++r) {
     meccano::TetMesh mesh = meccano::make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 3);
     const auto before = mesh.num_tets();
     const long rss_before = resident_kib();
     const auto start = Clock::now();
-    meccano::refine_uniformly(mesh, level - 3);
+    refine(mesh);
     row.seconds = std::min(row.seconds, seconds_since(start));
     row.tets = mesh.num_tets();
     row.new_tets = mesh.num_tets() - before;
     row.bytes_per_tet = mesh_bytes(mesh) / static_cast<double>(mesh.num_tets());
-    if (r == 0) row.rss_bytes_per_tet = static_cast<double>(resident_kib() - rss_before) * 1024.0 / static_cast<double>(mesh.num_tets());
+    if (r == 0)
+      row.rss_bytes_per_tet =
+          static_cast<double>(resident_kib() - rss_before) * 1024.0 / static_cast<double>(mesh.num_tets());
   }
   return row;
+}
+
+Row uniform(int level, int repeat) {
+  return measure("uniform, unit cube, level 3 -> " + std::to_string(level), repeat,
+                 [&](meccano::TetMesh& mesh) { meccano::refine_uniformly(mesh, level - 3); });
 }
 
 // Refines every tet whose vertices straddle the surface z = 0.5 + 0.15 sin(2πx) sin(2πy), or lie
 // within its longest edge of it, until the longest edge is below `resolution`.
 Row band(double resolution, int repeat) {
-  Row row;
   char label[96];
   std::snprintf(label, sizeof label, "band toward a curved surface, l_r = 1/%.0f", 1.0 / resolution);
-  row.what = label;
   auto height = [](const Eigen::Vector3d& p) {
     return p.z() - 0.5 - 0.15 * std::sin(2 * std::numbers::pi * p.x()) * std::sin(2 * std::numbers::pi * p.y());
   };
-  for (int r = 0; r < repeat; ++r) {
-    meccano::TetMesh mesh = meccano::make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 3);
-    const auto before = mesh.num_tets();
-    const long rss_before = resident_kib();
-    const auto start = Clock::now();
+  return measure(label, repeat, [&](meccano::TetMesh& mesh) {
     std::vector<meccano::TetId> marked;
     for (;;) {
       marked.clear();
@@ -110,13 +112,7 @@ Row band(double resolution, int repeat) {
       if (marked.empty()) break;
       meccano::refine_marked(mesh, marked);
     }
-    row.seconds = std::min(row.seconds, seconds_since(start));
-    row.tets = mesh.num_tets();
-    row.new_tets = mesh.num_tets() - before;
-    row.bytes_per_tet = mesh_bytes(mesh) / static_cast<double>(mesh.num_tets());
-    if (r == 0) row.rss_bytes_per_tet = static_cast<double>(resident_kib() - rss_before) * 1024.0 / static_cast<double>(mesh.num_tets());
-  }
-  return row;
+  });
 }
 
 }  // namespace
@@ -133,7 +129,7 @@ int main(int argc, char** argv) {
   std::printf("|%s|%s|%s|%s|%s|%s|%s|\n", std::string(46, '-').c_str(), std::string(12, '-').c_str(),
               std::string(12, '-').c_str(), std::string(10, '-').c_str(), std::string(10, '-').c_str(),
               std::string(11, '-').c_str(), std::string(11, '-').c_str());
-  for (int level = 15; level <= max_level; level += 3) print(uniform(level, repeat));
+  for (int level = 15; level <= max_level; ++level) print(uniform(level, repeat));
   for (double resolution : {1.0 / 16, 1.0 / 32, 1.0 / 64, 1.0 / 128}) print(band(resolution, repeat));
   return 0;
 }

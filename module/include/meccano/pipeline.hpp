@@ -1,0 +1,49 @@
+// The whole insertion, read top-down like the paper's four steps.
+//
+// Input    a meccano mesh (cube_meccano.hpp), surfaces that passed validate_surfaces, and options.
+// Steps    1. volumetric approximation V_M of each surface (volumetric_approximation.hpp);
+//          2-4. surface approximation and healing, projection, smoothing: not implemented yet.
+//          The surfaces are taken one after the other; a later surface's refinement keeps the earlier
+//          surfaces' regions in step (bisection does not change a region's point set).
+// Output   the refined mesh, each surface's V_M, per-stage statistics and timings.
+// Progress a callback receives one line per stage with counts.
+#pragma once
+
+#include <meccano/mesh_io.hpp>
+#include <meccano/surface.hpp>
+#include <meccano/tet_mesh.hpp>
+#include <meccano/volumetric_approximation.hpp>
+
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace meccano {
+
+enum class Stage { volumetric };
+
+struct InsertionOptions {
+  double resolution = 0.0;  // l_r, a length in physical units
+  Stage last_stage = Stage::volumetric;
+  std::function<void(const std::string&)> progress;
+};
+
+struct SurfaceInsertion {
+  std::string name;
+  TetRegion volumetric;  // V_M, one flag per tet of the final mesh
+  VolumetricStats volumetric_stats;
+  double volumetric_seconds = 0.0;
+};
+
+struct InsertionResult {
+  TetMesh mesh;
+  std::vector<SurfaceInsertion> surfaces;
+};
+
+InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options);
+
+// `domain`, the box sides, and `volumetric_NAME` for every surface's V_M.
+MeshGroups output_groups(const InsertionResult& result);
+
+}  // namespace meccano

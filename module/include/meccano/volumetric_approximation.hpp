@@ -1,0 +1,82 @@
+// Step 1 of the method (paper §4.1): the volumetric approximation V_M of an immersed surface S.
+//
+// Input    a conforming TetMesh (the cube meccano, possibly refined for other surfaces), S through its
+//          TriangleBVH, and the resolution l_r > 0.
+// Steps    1. V_M = the tets that intersect S. While some tet of V_M has l_T >= l_r (eq. 1, l_T the
+//             longest edge), bisect those tets (Kossaczky, conforming closure) and keep in V_M the
+//             children that still intersect S.
+//          2. Grow V_M into a topological ball: add the star (all tets of M around it) of every
+//             boundary node whose link in V_M is not a disk. The node Euler test of eq. 2,
+//             χ = n_E − n_F + n_T = 1, is necessary; the link must also be connected and its triangles
+//             around each link vertex must form one fan (eq. 2 alone accepts pinched links). Cavities
+//             (components of the complement that V_M encloses) are filled.
+//          In steps 2 and 3 a tet to be added whose longest edge is l_r or more is bisected instead
+//          (and the step repeats), so V_M stays made of tets finer than l_r, close to S.
+//          3. Grow V_M until every boundary face lies on a coordinate plane in computational
+//             coordinates, by adding the tet across each face that does not; step 2 is then re-run,
+//             until neither step changes V_M. If V_M then has disk links everywhere but a boundary
+//             that is not a sphere (a handle), it is thickened by the stars of its boundary nodes and
+//             the steps repeat.
+// Output   per-tet membership of V_M, and counts of what each step did.
+// Invariants on return (check_ball): V_M is face-connected, every boundary node has a disk link, the
+//          boundary is one closed 2-manifold with Euler characteristic 2, every boundary face is
+//          axis-parallel; every tet meeting S is in V_M and has l_T < l_r.
+// Errors   InputError for l_r <= 0; MeshingError if V_M cannot be made a ball within the pass limit.
+#pragma once
+
+#include <meccano/bisection.hpp>
+#include <meccano/geometry.hpp>
+#include <meccano/tet_mesh.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace meccano {
+
+// Per-tet flag of a region of the mesh (V_M); kept in step with refinement by region_follows_children.
+using TetRegion = std::vector<std::uint8_t>;
+
+// A ChildCallback that extends each region with the flag of the child's parent: bisection does not
+// change the point set of a region.
+ChildCallback region_follows_children(std::vector<TetRegion*> regions);
+
+struct VolumetricOptions {
+  double resolution = 0.0;  // l_r
+  int max_growth_passes = 200;
+};
+
+struct VolumetricStats {
+  int refinement_passes = 0;
+  std::int64_t bisections = 0;
+  std::int64_t intersection_tests = 0;
+  std::int64_t tets_intersecting = 0;  // tets of V_M after refinement, before growth
+  std::int64_t euler_node_stars = 0;   // nodes whose star was added by the link test
+  std::int64_t cavity_tets = 0;
+  std::int64_t axis_tets = 0;          // tets added to make the boundary axis-parallel
+  int thickening_layers = 0;           // layers added to close handles the link test cannot see
+  int growth_refinements = 0;          // times the growth bisected tets not finer than l_r
+  int growth_passes = 0;
+  std::int64_t tets = 0;               // tets of V_M at the end
+};
+
+// Runs steps 1-3. `other_regions` (e.g. the V_M of surfaces inserted before) follow the refinement.
+TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const VolumetricOptions& options,
+                             VolumetricStats& stats, std::vector<TetRegion*> other_regions = {});
+
+struct BallCheck {
+  bool nonempty = false;
+  bool connected = false;
+  std::int64_t non_disk_links = 0;        // boundary nodes whose link in the region is not a disk
+  std::int64_t non_manifold_edges = 0;    // boundary edges not in exactly two boundary faces
+  int boundary_components = 0;
+  std::int64_t boundary_euler = 0;        // V - E + F of the boundary surface
+  std::int64_t non_axis_faces = 0;        // boundary faces not on a coordinate plane
+  bool is_ball() const {
+    return nonempty && connected && non_disk_links == 0 && non_manifold_edges == 0 && boundary_components == 1 &&
+           boundary_euler == 2;
+  }
+};
+
+BallCheck check_ball(const TetMesh& mesh, const TetRegion& region);
+
+}  // namespace meccano

@@ -1,0 +1,425 @@
+#include <meccano/volumetric_approximation.hpp>
+
+#include <meccano/error.hpp>
+
+#include <algorithm>
+#include <numeric>
+#include <string>
+
+namespace meccano {
+namespace {
+
+class UnionFind {
+ public:
+  explicit UnionFind(int n) { reset(n); }
+  void reset(int n) {
+    parent_.resize(static_cast<std::size_t>(n));
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
+  int find(int i) {
+    while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
+    return i;
+  }
+  void join(int a, int b) { parent_[find(a)] = find(b); }
+  int components() {
+    int count = 0;
+    for (int i = 0; i < static_cast<int>(parent_.size()); ++i) count += find(i) == i;
+    return count;
+  }
+
+ private:
+  std::vector<int> parent_;
+};
+
+using Edge = std::pair<VertexId, VertexId>;
+Edge make_edge(VertexId a, VertexId b) { return a < b ? Edge{a, b} : Edge{b, a}; }
+
+// Whether the link of `node` in the region is a disk: the triangles opposite `node` in the region's
+// tets around it must be connected, have Euler characteristic 1 (eq. 2: n_E - n_F + n_T counts the
+// link's vertices, edges and triangles), have a boundary, and form a single fan around each vertex.
+// The link lies in the boundary of the node's star in M, a 2-manifold, so every link edge is in at
+// most two link triangles and a link vertex with d triangles and i interior edges has one closed fan
+// when i = d and d - i open fans otherwise. `scratch` is reused between calls to avoid allocation.
+struct LinkScratch {
+  std::vector<std::array<VertexId, 3>> triangles;
+  std::vector<std::pair<Edge, int>> edges;  // (edge, triangle)
+  std::vector<std::pair<VertexId, int>> vertex_counts;  // (vertex, triangles - interior edges)
+  UnionFind components{0};
+};
+
+bool link_is_disk(const TetMesh& mesh, const TetRegion& region, const VertexTets& incidence, VertexId node,
+                  LinkScratch& scratch) {
+  auto& triangles = scratch.triangles;
+  auto& edges = scratch.edges;
+  auto& counts = scratch.vertex_counts;
+  triangles.clear();
+  edges.clear();
+  counts.clear();
+  for (TetId t : incidence.of(node)) {
+    if (!region[t]) continue;
+    std::array<VertexId, 3> opposite{};
+    int k = 0;
+    for (VertexId v : mesh.tets[t])
+      if (v != node) opposite[k++] = v;
+    triangles.push_back(opposite);
+  }
+  const int n = static_cast<int>(triangles.size());
+  if (n == 0) return false;
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      edges.push_back({make_edge(triangles[i][k], triangles[i][(k + 1) % 3]), i});
+      counts.push_back({triangles[i][k], 1});
+    }
+  std::sort(edges.begin(), edges.end());
+
+  std::int64_t distinct_edges = 0;
+  bool has_boundary = false;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    ++distinct_edges;
+    if (j - i == 1) has_boundary = true;
+    if (j - i == 2) {  // an interior edge: one less open fan at each of its ends
+      counts.push_back({edges[i].first.first, -1});
+      counts.push_back({edges[i].first.second, -1});
+    }
+    i = j;
+  }
+  // Connectivity of the triangles across shared edges.
+  scratch.components.reset(n);
+  for (std::size_t i = 0; i + 1 < edges.size(); ++i)
+    if (edges[i].first == edges[i + 1].first) scratch.components.join(edges[i].second, edges[i + 1].second);
+  if (scratch.components.components() != 1) return false;
+
+  std::sort(counts.begin(), counts.end());
+  std::int64_t vertices = 0;
+  for (std::size_t i = 0; i < counts.size();) {
+    std::size_t j = i;
+    int open_fans = 0;
+    while (j < counts.size() && counts[j].first == counts[i].first) open_fans += counts[j++].second;
+    ++vertices;
+    if (open_fans > 1) return false;
+    i = j;
+  }
+  return has_boundary && vertices - distinct_edges + n == 1;
+}
+
+// Flags, for each node in `nodes`, whether its link in the region is not a disk (in parallel).
+std::vector<std::uint8_t> non_disk_links(const TetMesh& mesh, const TetRegion& region, const VertexTets& incidence,
+                                         const std::vector<VertexId>& nodes) {
+  std::vector<std::uint8_t> bad(nodes.size(), 0);
+  const auto count = static_cast<std::int64_t>(nodes.size());
+#pragma omp parallel
+  {
+    LinkScratch scratch;
+#pragma omp for schedule(dynamic, 512)
+    for (std::int64_t i = 0; i < count; ++i) bad[i] = !link_is_disk(mesh, region, incidence, nodes[i], scratch);
+  }
+  return bad;
+}
+
+bool face_is_axis_parallel(const TetMesh& mesh, TetId t, int f) {
+  const auto& v = mesh.tets[t];
+  const auto& local = face_vertices[f];
+  for (int axis = 0; axis < 3; ++axis) {
+    const std::int64_t c = mesh.grid[v[local[0]]][axis];
+    if (mesh.grid[v[local[1]]][axis] == c && mesh.grid[v[local[2]]][axis] == c) return true;
+  }
+  return false;
+}
+
+bool is_boundary_face(const TetMesh& mesh, const TetRegion& region, TetId t, int f) {
+  const TetId across = mesh.neighbours[t][f];
+  return across == no_tet || !region[across];
+}
+
+std::vector<VertexId> boundary_nodes(const TetMesh& mesh, const TetRegion& region) {
+  std::vector<std::uint8_t> on_boundary(mesh.points.size(), 0);
+  for (TetId t = 0; t < mesh.num_tets(); ++t) {
+    if (!region[t]) continue;
+    for (int f = 0; f < 4; ++f)
+      if (is_boundary_face(mesh, region, t, f))
+        for (int local : face_vertices[f]) on_boundary[mesh.tets[t][local]] = 1;
+  }
+  std::vector<VertexId> nodes;
+  for (VertexId v = 0; v < mesh.num_vertices(); ++v)
+    if (on_boundary[v]) nodes.push_back(v);
+  return nodes;
+}
+
+// Components of the complement (face-connected tets outside the region).
+std::vector<int> complement_components(const TetMesh& mesh, const TetRegion& region, int& count) {
+  std::vector<int> component(mesh.tets.size(), -1);
+  count = 0;
+  std::vector<TetId> stack;
+  for (TetId seed = 0; seed < mesh.num_tets(); ++seed) {
+    if (region[seed] || component[seed] >= 0) continue;
+    component[seed] = count;
+    stack.push_back(seed);
+    while (!stack.empty()) {
+      const TetId t = stack.back();
+      stack.pop_back();
+      for (TetId u : mesh.neighbours[t])
+        if (u != no_tet && !region[u] && component[u] < 0) {
+          component[u] = count;
+          stack.push_back(u);
+        }
+    }
+    ++count;
+  }
+  return component;
+}
+
+// Adds to the region every complement component that does not reach the box boundary (or, if none
+// does, every component but the largest): V_M must not enclose cavities.
+std::int64_t fill_cavities(const TetMesh& mesh, TetRegion& region) {
+  int count = 0;
+  const std::vector<int> component = complement_components(mesh, region, count);
+  if (count <= 1) return 0;
+  std::vector<std::uint8_t> outside(count, 0);
+  std::vector<std::int64_t> size(count, 0);
+  for (TetId t = 0; t < mesh.num_tets(); ++t) {
+    if (component[t] < 0) continue;
+    ++size[component[t]];
+    for (TetId u : mesh.neighbours[t])
+      if (u == no_tet) outside[component[t]] = 1;
+  }
+  if (std::none_of(outside.begin(), outside.end(), [](std::uint8_t o) { return o != 0; }))
+    outside[std::max_element(size.begin(), size.end()) - size.begin()] = 1;
+  std::int64_t added = 0;
+  for (TetId t = 0; t < mesh.num_tets(); ++t)
+    if (component[t] >= 0 && !outside[component[t]]) {
+      region[t] = 1;
+      ++added;
+    }
+  return added;
+}
+
+// The stars of the boundary nodes whose link is not a disk.
+std::vector<TetId> stars_of_non_disk_nodes(const TetMesh& mesh, const TetRegion& region, std::int64_t& nodes) {
+  const VertexTets incidence = vertex_to_tets(mesh);
+  const std::vector<VertexId> candidates = boundary_nodes(mesh, region);
+  const std::vector<std::uint8_t> bad = non_disk_links(mesh, region, incidence, candidates);
+  std::vector<TetId> tets;
+  nodes = 0;
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    if (bad[i]) {
+      ++nodes;
+      for (TetId t : incidence.of(candidates[i]))
+        if (!region[t]) tets.push_back(t);
+    }
+  return tets;
+}
+
+// The tets across boundary faces that do not lie on a coordinate plane.
+std::vector<TetId> tets_across_oblique_faces(const TetMesh& mesh, const TetRegion& region) {
+  std::vector<TetId> across;
+  for (TetId t = 0; t < mesh.num_tets(); ++t) {
+    if (!region[t]) continue;
+    for (int f = 0; f < 4; ++f)
+      if (is_boundary_face(mesh, region, t, f) && !face_is_axis_parallel(mesh, t, f))
+        across.push_back(mesh.neighbours[t][f]);  // never no_tet: box sides are axis-parallel
+  }
+  return across;
+}
+
+// The stars of all boundary nodes: one layer around the region.
+std::vector<TetId> layer_around(const TetMesh& mesh, const TetRegion& region) {
+  const VertexTets incidence = vertex_to_tets(mesh);
+  std::vector<TetId> tets;
+  for (VertexId node : boundary_nodes(mesh, region))
+    for (TetId t : incidence.of(node))
+      if (!region[t]) tets.push_back(t);
+  return tets;
+}
+
+// Everything check_ball checks but the node links (BallCheck::non_disk_links stays 0).
+BallCheck boundary_topology(const TetMesh& mesh, const TetRegion& region,
+                            std::vector<VertexId>* boundary_vertices = nullptr);
+
+bool intersects(const TetMesh& mesh, const TriangleBVH& surface, TetId t) {
+  return surface.intersects_tetrahedron(mesh.tet_points(t));
+}
+
+}  // namespace
+
+ChildCallback region_follows_children(std::vector<TetRegion*> regions) {
+  return [regions = std::move(regions)](TetId parent, TetId /*child1*/) {
+    for (TetRegion* region : regions) region->push_back((*region)[parent]);
+  };
+}
+
+TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const VolumetricOptions& options,
+                             VolumetricStats& stats, std::vector<TetRegion*> other_regions) {
+  if (!(options.resolution > 0.0))
+    throw InputError("the resolution l_r must be positive (got " + std::to_string(options.resolution) + ")");
+
+  // Step 1: refine the tets meeting S until they are shorter than l_r.
+  TetRegion region(mesh.tets.size(), 0);
+  const auto initial = mesh.num_tets();
+#pragma omp parallel for schedule(dynamic, 256)
+  for (TetId t = 0; t < initial; ++t) region[t] = intersects(mesh, surface, t);
+  stats.intersection_tests += initial;
+
+  const ChildCallback follow_others = region_follows_children(std::move(other_regions));
+  std::vector<TetId> marked, retest;
+  std::vector<std::uint8_t> queued;
+  for (;;) {
+    marked.clear();
+    for (TetId t = 0; t < mesh.num_tets(); ++t)
+      if (region[t] && mesh.longest_edge(t) >= options.resolution) marked.push_back(t);
+    if (marked.empty()) break;
+    ++stats.refinement_passes;
+    retest.clear();
+    queued.assign(mesh.tets.size(), 0);
+    auto queue = [&](TetId t) {
+      if (!queued[t]) {
+        queued[t] = 1;
+        retest.push_back(t);
+      }
+    };
+    stats.bisections += refine_marked(mesh, marked, [&](TetId parent, TetId child) {
+      follow_others(parent, child);
+      region.push_back(region[parent]);
+      queued.push_back(0);
+      if (region[parent]) {
+        queue(parent);
+        queue(child);
+      }
+    });
+    const auto count = static_cast<std::int64_t>(retest.size());
+#pragma omp parallel for schedule(dynamic, 256)
+    for (std::int64_t i = 0; i < count; ++i) region[retest[i]] = intersects(mesh, surface, retest[i]);
+    stats.intersection_tests += count;
+  }
+  stats.tets_intersecting = std::count(region.begin(), region.end(), 1);
+  if (stats.tets_intersecting == 0) throw MeshingError("the surface meets no tet of the mesh");
+
+  // Steps 2 and 3: grow into a ball with axis-parallel boundary faces. A tet the growth wants that is
+  // not finer than l_r is bisected instead of added: adding coarse tets would pull far-away, coarse
+  // parts of the mesh into V_M (each brings new oblique faces and pinched nodes further out).
+  auto grow = [&](const std::vector<TetId>& wanted) -> std::int64_t {
+    std::vector<TetId> coarse;
+    std::int64_t added = 0;
+    for (TetId t : wanted) {
+      if (region[t]) continue;
+      if (mesh.longest_edge(t) >= options.resolution) {
+        coarse.push_back(t);
+      } else {
+        region[t] = 1;
+        ++added;
+      }
+    }
+    if (!coarse.empty()) {
+      std::sort(coarse.begin(), coarse.end());
+      coarse.erase(std::unique(coarse.begin(), coarse.end()), coarse.end());
+      stats.bisections += refine_marked(mesh, coarse, [&](TetId parent, TetId child) {
+        follow_others(parent, child);
+        region.push_back(region[parent]);
+      });
+      ++stats.growth_refinements;
+    }
+    return added + static_cast<std::int64_t>(coarse.size());
+  };
+  // Cheapest checks first: the link test visits every boundary node, so it runs once the boundary is
+  // axis-parallel and free of cavities.
+  for (stats.growth_passes = 1; stats.growth_passes <= options.max_growth_passes; ++stats.growth_passes) {
+    if (const auto across = tets_across_oblique_faces(mesh, region); !across.empty()) {
+      stats.axis_tets += grow(across);
+      continue;
+    }
+    if (const auto n = fill_cavities(mesh, region); n > 0) {
+      stats.cavity_tets += n;
+      continue;
+    }
+    std::int64_t bad_nodes = 0;
+    if (const auto stars = stars_of_non_disk_nodes(mesh, region, bad_nodes); bad_nodes > 0) {
+      stats.euler_node_stars += bad_nodes;
+      grow(stars);
+      continue;
+    }
+    if (boundary_topology(mesh, region).is_ball()) {  // links were just found to be disks
+      stats.tets = std::count(region.begin(), region.end(), 1);
+      return region;
+    }
+    // Every link is a disk but the boundary is not a sphere (a handle): thicken V_M by one layer.
+    ++stats.thickening_layers;
+    grow(layer_around(mesh, region));
+  }
+  throw MeshingError("the volumetric approximation could not be grown into a topological ball in " +
+                     std::to_string(options.max_growth_passes) + " passes");
+}
+
+BallCheck check_ball(const TetMesh& mesh, const TetRegion& region) {
+  std::vector<VertexId> vertices;
+  BallCheck check = boundary_topology(mesh, region, &vertices);
+  const VertexTets incidence = vertex_to_tets(mesh);
+  const auto bad = non_disk_links(mesh, region, incidence, vertices);
+  check.non_disk_links = std::count(bad.begin(), bad.end(), 1);
+  return check;
+}
+
+namespace {
+
+BallCheck boundary_topology(const TetMesh& mesh, const TetRegion& region, std::vector<VertexId>* boundary_vertices) {
+  BallCheck check;
+  std::vector<TetId> members;
+  for (TetId t = 0; t < mesh.num_tets(); ++t)
+    if (region[t]) members.push_back(t);
+  check.nonempty = !members.empty();
+  if (!check.nonempty) return check;
+
+  // Face-connectivity of the region.
+  std::vector<std::uint8_t> seen(mesh.tets.size(), 0);
+  std::vector<TetId> stack{members.front()};
+  seen[members.front()] = 1;
+  std::size_t reached = 0;
+  while (!stack.empty()) {
+    const TetId t = stack.back();
+    stack.pop_back();
+    ++reached;
+    for (TetId u : mesh.neighbours[t])
+      if (u != no_tet && region[u] && !seen[u]) {
+        seen[u] = 1;
+        stack.push_back(u);
+      }
+  }
+  check.connected = reached == members.size();
+
+  // The boundary surface: its faces, edges (with the faces on them) and vertices.
+  std::vector<std::array<VertexId, 3>> faces;
+  for (TetId t : members)
+    for (int f = 0; f < 4; ++f)
+      if (is_boundary_face(mesh, region, t, f)) {
+        faces.push_back(mesh.outward_face(t, f));
+        check.non_axis_faces += !face_is_axis_parallel(mesh, t, f);
+      }
+  std::vector<std::pair<Edge, int>> edges;
+  std::vector<VertexId> vertices;
+  for (int i = 0; i < static_cast<int>(faces.size()); ++i)
+    for (int k = 0; k < 3; ++k) {
+      edges.push_back({make_edge(faces[i][k], faces[i][(k + 1) % 3]), i});
+      vertices.push_back(faces[i][k]);
+    }
+  std::sort(edges.begin(), edges.end());
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  UnionFind components(static_cast<int>(faces.size()));
+  std::int64_t distinct_edges = 0;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    ++distinct_edges;
+    if (j - i != 2) ++check.non_manifold_edges;
+    for (std::size_t k = i + 1; k < j; ++k) components.join(edges[i].second, edges[k].second);
+    i = j;
+  }
+  check.boundary_components = components.components();
+  check.boundary_euler = static_cast<std::int64_t>(vertices.size()) - distinct_edges + static_cast<std::int64_t>(faces.size());
+  if (boundary_vertices) *boundary_vertices = std::move(vertices);
+  return check;
+}
+
+}  // namespace
+
+}  // namespace meccano

@@ -1,0 +1,51 @@
+// Volumetric approximation benchmark (paper §4.1): the cube example's surface (the paper-like patch,
+// 96 x 96 grid, 18 432 triangles) inserted into the unit-cube meccano for l_r from 1/16 to 1/256 of the
+// box size. Prints a Markdown table: seconds of the stage (best of the repetitions), tets tested for
+// intersection per second, refinement passes, final mesh size and V_M size.
+//
+// Usage: bench_volumetric [--repeat N] [--finest K]   (l_r down to 1/2^K, default K = 8)
+
+#include <meccano/cube_meccano.hpp>
+#include <meccano/volumetric_approximation.hpp>
+
+#include <test_surfaces.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <string>
+
+int main(int argc, char** argv) {
+  int repeat = 3;
+  int finest = 8;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--repeat")) repeat = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--finest")) finest = std::atoi(argv[i + 1]);
+  }
+  const meccano::TriangleSurface surface = meccano::testing::paper_like_patch(96);
+  const meccano::TriangleBVH tree(surface);
+  std::printf("| %8s | %6s | %10s | %8s | %8s | %10s | %8s |\n", "l_r", "passes", "tets", "V_M tets", "seconds",
+              "tests", "M tests/s");
+  std::printf("|----------|--------|------------|----------|----------|------------|----------|\n");
+  for (int k = 4; k <= finest; ++k) {
+    const double resolution = 1.0 / (1 << k);
+    double best = std::numeric_limits<double>::infinity();
+    meccano::VolumetricStats stats;
+    std::int64_t tets = 0;
+    for (int r = 0; r < repeat; ++r) {
+      meccano::TetMesh mesh = meccano::make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
+      stats = {};
+      const auto start = std::chrono::steady_clock::now();
+      meccano::approximate_volume(mesh, tree, {resolution}, stats);
+      best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      tets = mesh.num_tets();
+    }
+    std::printf("| 1/%-6d | %6d | %10lld | %8lld | %8.3f | %10lld | %8.2f |\n", 1 << k, stats.refinement_passes,
+                static_cast<long long>(tets), static_cast<long long>(stats.tets), best,
+                static_cast<long long>(stats.intersection_tests),
+                static_cast<double>(stats.intersection_tests) / best / 1e6);
+    std::fflush(stdout);
+  }
+  return 0;
+}

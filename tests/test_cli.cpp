@@ -1,0 +1,202 @@
+// The meccano-immerse command line: exit statuses, messages, outputs read back by the Gmsh library,
+// and bad input that must fail with its own message and leave no file behind.
+
+#include <meccano/surface.hpp>
+
+#include <test_surfaces.hpp>
+
+#include <gmsh.h>
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace meccano {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status = -1;
+  std::string output;  // stdout and stderr
+};
+
+CliRun run_cli(const std::string& arguments) {
+  const std::string command = std::string(MECCANO_CLI) + " " + arguments + " 2>&1";
+  CliRun run;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return run;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) run.output += buffer.data();
+  const int raw = ::pclose(pipe);
+  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return run;
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("meccano-cli-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  std::string write_obj(const std::string& name, const TriangleSurface& surface) const {
+    std::ofstream out(path(name));
+    out.precision(17);
+    for (const auto& p : surface.points) out << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+    for (const auto& t : surface.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    return path(name);
+  }
+
+  bool only_inputs_in_directory(std::size_t inputs) const {
+    return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir_), fs::directory_iterator())) == inputs;
+  }
+
+  fs::path dir_;
+};
+
+std::map<std::string, std::size_t> group_sizes(const std::string& file) {
+  gmsh::initialize();
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::open(file);
+  std::map<std::string, std::size_t> sizes;
+  gmsh::vectorpair groups;
+  gmsh::model::getPhysicalGroups(groups);
+  for (const auto& [dim, tag] : groups) {
+    std::string name;
+    gmsh::model::getPhysicalName(dim, tag, name);
+    std::vector<int> entities;
+    gmsh::model::getEntitiesForPhysicalGroup(dim, tag, entities);
+    for (int entity : entities) {
+      std::vector<int> types;
+      std::vector<std::vector<std::size_t>> tags, nodes;
+      gmsh::model::mesh::getElements(types, tags, nodes, dim, entity);
+      for (const auto& t : tags) sizes[name] += t.size();
+    }
+  }
+  gmsh::finalize();
+  return sizes;
+}
+
+TEST_F(CliTest, HelpExitsZeroWithExamples) {
+  const CliRun run = run_cli("--help");
+  EXPECT_EQ(run.status, 0);
+  EXPECT_NE(run.output.find("--box X0,Y0,Z0,X1,Y1,Z1"), std::string::npos);
+  EXPECT_NE(run.output.find("Examples:"), std::string::npos);
+}
+
+TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
+  const std::map<std::string, std::string> cases{
+      {"--level 2 --output " + path("a.msh"), "--box is required"},
+      {"--box 0,0,0,1,1,1", "--output is required"},
+      {"--box 0,0,0,1,1 --output " + path("a.msh"), "takes 6 comma-separated numbers"},
+      {"--box 0,0,0,1,x,1 --output " + path("a.msh"), "is not a finite number"},
+      {"--box 0,0,0,1,1,1 --level -1 --output " + path("a.msh"), "--level must be between"},
+      {"--box 0,0,0,1,1,1 --frobnicate --output " + path("a.msh"), "unknown option"},
+      {"--box 0,0,0,1,1,1 --output " + path("a.vtk"), "only .msh output"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --stage volumetric --output " + path("a.msh"), "--surface needs --resolution"},
+      {"--box 0,0,0,1,1,1 --resolution 0.1 --output " + path("a.msh"), "need at least one --surface"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0 --stage volumetric --output " + path("a.msh"),
+       "--resolution must be positive"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --stage smoothing --output " + path("a.msh"),
+       "the stages available are"},
+  };
+  for (const auto& [arguments, message] : cases) {
+    const CliRun run = run_cli(arguments);
+    EXPECT_EQ(run.status, 2) << arguments << "\n" << run.output;
+    EXPECT_NE(run.output.find(message), std::string::npos) << arguments << "\n" << run.output;
+  }
+  EXPECT_TRUE(only_inputs_in_directory(0));
+}
+
+TEST_F(CliTest, WritesTheMeccanoMeshWithBoxGroups) {
+  const CliRun run = run_cli("--box 0,0,0,2,1,1 --level 4 --quiet --output " + path("bar.msh"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_TRUE(run.output.empty()) << "--quiet printed: " << run.output;
+  const auto sizes = group_sizes(path("bar.msh"));
+  EXPECT_EQ(sizes.at("domain"), 2u * 6 * 16);
+  for (const char* side : {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}) EXPECT_GT(sizes.at(side), 0u) << side;
+}
+
+TEST_F(CliTest, ProgressReportsEachStageWithCounts) {
+  const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + surface + ":patch --resolution 0.1 --stage volumetric --output " +
+                          path("vm.msh"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("surface patch:"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("volumetric patch:"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("wrote"), std::string::npos) << run.output;
+}
+
+TEST_F(CliTest, VolumetricStageWritesOneGroupPerSurface) {
+  const auto pair = testing::stacked_pair(8);
+  const std::string lower = write_obj("lower.obj", pair[0]);
+  const std::string upper = write_obj("upper.obj", pair[1]);
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + lower + " --surface " + upper +
+                          ":top --resolution 0.08 --stage volumetric --quiet --output " + path("vm.msh"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  const auto sizes = group_sizes(path("vm.msh"));
+  ASSERT_TRUE(sizes.count("volumetric_1")) << "the first surface is named by its position";
+  ASSERT_TRUE(sizes.count("volumetric_top"));
+  EXPECT_GT(sizes.at("volumetric_1"), 0u);
+  EXPECT_GT(sizes.at("volumetric_top"), 0u);
+  EXPECT_LT(sizes.at("volumetric_1"), sizes.at("domain"));
+}
+
+TEST_F(CliTest, BadSurfacesFailWithTheirOwnMessageAndWriteNothing) {
+  const TriangleSurface patch = testing::paper_like_patch(6);
+  TriangleSurface outside = patch;
+  outside.points[0].z() = 1.5;
+  TriangleSurface on_boundary = patch;
+  on_boundary.points[0].x() = 0.0;
+  TriangleSurface flipped = patch;
+  std::swap(flipped.triangles[3][0], flipped.triangles[3][1]);
+  const std::map<std::string, std::pair<TriangleSurface, std::string>> cases{
+      {"outside.obj", {outside, "outside the box"}},
+      {"boundary.obj", {on_boundary, "on the box boundary"}},
+      {"flipped.obj", {flipped, "orientation"}},
+  };
+  for (const auto& [name, surface_and_message] : cases) {
+    const std::string file = write_obj(name, surface_and_message.first);
+    const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + file + " --resolution 0.1 --stage volumetric --output " +
+                            path("out.msh"));
+    EXPECT_EQ(run.status, 1) << name << "\n" << run.output;
+    EXPECT_NE(run.output.find(name), std::string::npos) << "the message names the file\n" << run.output;
+    EXPECT_NE(run.output.find(surface_and_message.second), std::string::npos) << run.output;
+    EXPECT_FALSE(fs::exists(path("out.msh")));
+  }
+  // The tilted plane crosses the patch.
+  const std::string file = write_obj("patch.obj", patch);
+  const std::string crossing = write_obj("plane.obj", testing::tilted_plane(6));
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + file + " --surface " + crossing + " --resolution 0.1 "
+                          "--stage volumetric --output " + path("out.msh"));
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_NE(run.output.find("intersect"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(path("out.msh")));
+  const CliRun missing = run_cli("--box 0,0,0,1,1,1 --surface " + path("none.obj") + " --resolution 0.1 --stage volumetric "
+                              "--output " + path("out.msh"));
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.output.find("none.obj"), std::string::npos) << missing.output;
+  EXPECT_TRUE(only_inputs_in_directory(5));
+}
+
+TEST_F(CliTest, UnwritableOutputFailsWithStatusOne) {
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --level 1 --output /nonexistent-dir/out.msh");
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_NE(run.output.find("cannot write /nonexistent-dir/out.msh"), std::string::npos) << run.output;
+}
+
+}  // namespace
+}  // namespace meccano

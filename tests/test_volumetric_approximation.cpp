@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <unordered_map>
 
 namespace meccano {
@@ -207,6 +208,94 @@ TEST(BallCheck, DetectsPinchedAndDisconnectedRegions) {
   EXPECT_FALSE(pinched.is_ball());
   // One tet alone is a ball.
   region[second] = 0;
+  EXPECT_TRUE(check_ball(mesh, region).is_ball());
+}
+
+// Tets whose computational centroid lies in the cells (i, j, k) of a grid of 1/8 cube cells.
+TetRegion cells_region(const TetMesh& mesh, const std::function<bool(int, int, int)>& in_cell) {
+  TetRegion region(mesh.tets.size(), 0);
+  for (TetId t = 0; t < mesh.num_tets(); ++t) {
+    std::array<double, 3> centroid{};
+    for (VertexId v : mesh.tets[t])
+      for (int k = 0; k < 3; ++k) centroid[k] += static_cast<double>(mesh.grid[v][k]) / grid_cell / 4;
+    region[t] = in_cell(static_cast<int>(centroid[0] * 8), static_cast<int>(centroid[1] * 8),
+                        static_cast<int>(centroid[2] * 8));
+  }
+  return region;
+}
+
+void expect_grows_into_ball(TetMesh& mesh, TetRegion region, double resolution) {
+  const std::vector<std::uint8_t> before = region;
+  VolumetricStats stats;
+  grow_into_ball(mesh, region, {resolution}, stats);
+  const BallCheck check = check_ball(mesh, region);
+  EXPECT_TRUE(check.is_ball()) << "components " << check.boundary_components << " Euler " << check.boundary_euler;
+  EXPECT_EQ(check.non_axis_faces, 0);
+  for (std::size_t t = 0; t < before.size(); ++t) ASSERT_TRUE(!before[t] || region[t]) << "growth lost tet " << t;
+  EXPECT_TRUE(verify_mesh(mesh).ok());
+}
+
+TEST(GrowIntoBall, JoinsTetsThatShareOnlyAVertex) {
+  TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 9);  // cells of 1/8
+  TetRegion region(mesh.tets.size(), 0);
+  const VertexTets incidence = vertex_to_tets(mesh);
+  const VertexId centre = [&] {
+    for (VertexId v = 0; v < mesh.num_vertices(); ++v)
+      if (mesh.grid[v] == GridPoint{grid_cell / 2, grid_cell / 2, grid_cell / 2}) return v;
+    return VertexId{-1};
+  }();
+  ASSERT_GE(centre, 0);
+  const auto star = incidence.of(centre);
+  region[star.front()] = 1;
+  for (TetId t : star) {  // a second tet of the star sharing only the centre with the first
+    int common = 0;
+    for (VertexId v : mesh.tets[t]) common += static_cast<int>(std::count(mesh.tets[star.front()].begin(), mesh.tets[star.front()].end(), v));
+    if (common == 1) {
+      region[t] = 1;
+      break;
+    }
+  }
+  ASSERT_FALSE(check_ball(mesh, region).is_ball());
+  expect_grows_into_ball(mesh, region, 1.0);
+}
+
+TEST(GrowIntoBall, FillsAHollowShell) {
+  TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 9);
+  // A 4x4x4 block of cells without its 2x2x2 core: a sphere-with-a-cavity boundary.
+  const TetRegion shell = cells_region(mesh, [](int i, int j, int k) {
+    auto in = [](int c, int lo, int hi) { return c >= lo && c < hi; };
+    return in(i, 2, 6) && in(j, 2, 6) && in(k, 2, 6) && !(in(i, 3, 5) && in(j, 3, 5) && in(k, 3, 5));
+  });
+  const BallCheck before = check_ball(mesh, shell);
+  EXPECT_EQ(before.boundary_components, 2);
+  expect_grows_into_ball(mesh, shell, 1.0);
+}
+
+TEST(GrowIntoBall, ClosesASolidTorus) {
+  TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 9);
+  // A ring of 8 cells around an empty one, one cell thick: boundary Euler characteristic 0.
+  const TetRegion ring = cells_region(mesh, [](int i, int j, int k) {
+    return k == 4 && i >= 3 && i <= 5 && j >= 3 && j <= 5 && !(i == 4 && j == 4);
+  });
+  const BallCheck before = check_ball(mesh, ring);
+  EXPECT_EQ(before.boundary_euler, 0);
+  EXPECT_EQ(before.non_disk_links, 0) << "the link test alone cannot see a handle";
+  expect_grows_into_ball(mesh, ring, 1.0);
+}
+
+TEST(GrowIntoBall, RefinesCoarseTetsInsteadOfAddingThem) {
+  TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 3);
+  TetRegion region(mesh.tets.size(), 0);
+  region[0] = region[1] = 1;
+  TetRegion descends_from_start = region;  // follows refinement like any other region
+  VolumetricStats stats;
+  grow_into_ball(mesh, region, {0.2}, stats, {&descends_from_start});
+  ASSERT_EQ(descends_from_start.size(), mesh.tets.size());
+  EXPECT_GT(stats.growth_refinements, 0);
+  for (TetId t = 0; t < mesh.num_tets(); ++t) {
+    if (!region[t] || descends_from_start[t]) continue;
+    ASSERT_LT(mesh.longest_edge(t), 0.2) << "a coarse tet was added";
+  }
   EXPECT_TRUE(check_ball(mesh, region).is_ball());
 }
 

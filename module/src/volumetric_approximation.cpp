@@ -261,7 +261,7 @@ TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const Vo
   for (TetId t = 0; t < initial; ++t) region[t] = intersects(mesh, surface, t);
   stats.intersection_tests += initial;
 
-  const ChildCallback follow_others = region_follows_children(std::move(other_regions));
+  const ChildCallback follow_others = region_follows_children(other_regions);
   std::vector<TetId> marked, retest;
   std::vector<std::uint8_t> queued;
   for (;;) {
@@ -294,7 +294,13 @@ TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const Vo
   }
   stats.tets_intersecting = std::count(region.begin(), region.end(), 1);
   if (stats.tets_intersecting == 0) throw MeshingError("the surface meets no tet of the mesh");
+  grow_into_ball(mesh, region, options, stats, std::move(other_regions));
+  return region;
+}
 
+void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& options, VolumetricStats& stats,
+                    std::vector<TetRegion*> other_regions) {
+  const ChildCallback follow_others = region_follows_children(std::move(other_regions));
   // Steps 2 and 3: grow into a ball with axis-parallel boundary faces. A tet the growth wants that is
   // not finer than l_r is bisected instead of added: adding coarse tets would pull far-away, coarse
   // parts of the mesh into V_M (each brings new oblique faces and pinched nodes further out).
@@ -340,7 +346,7 @@ TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const Vo
     }
     if (boundary_topology(mesh, region).is_ball()) {  // links were just found to be disks
       stats.tets = std::count(region.begin(), region.end(), 1);
-      return region;
+      return;
     }
     // Every link is a disk but the boundary is not a sphere (a handle): thicken V_M by one layer.
     ++stats.thickening_layers;

@@ -3,6 +3,9 @@
 // box size. Prints a Markdown table: seconds of the stage (best of the repetitions), tets tested for
 // intersection per second, refinement passes, final mesh size and V_M size.
 //
+// A second table measures, for every test surface at l_r = 1/32, what the growth into a ball did and
+// how far the boundary nodes of V_M are from S, in units of l_r.
+//
 // Usage: bench_volumetric [--repeat N] [--finest K]   (l_r down to 1/2^K, default K = 8)
 
 #include <meccano/cube_meccano.hpp>
@@ -11,6 +14,7 @@
 #include <test_surfaces.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -46,6 +50,36 @@ int main(int argc, char** argv) {
                 static_cast<long long>(stats.intersection_tests),
                 static_cast<double>(stats.intersection_tests) / best / 1e6);
     std::fflush(stdout);
+  }
+  std::printf("\n| %-22s | %8s | %8s | %9s | %8s | %10s | %8s | %8s |\n", "surface (l_r = 1/32)", "tets", "V_M", "meet S",
+              "axis", "node stars", "max d/l_r", "mean d/l_r");
+  std::printf("|------------------------|----------|----------|-----------|----------|------------|----------|----------|\n");
+  const double resolution = 1.0 / 32;
+  for (const auto& named : meccano::testing::named_test_surfaces(24)) {
+    meccano::TetMesh mesh = meccano::make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
+    const meccano::TriangleBVH first(named.surfaces.front());
+    meccano::VolumetricStats stats;
+    const meccano::TetRegion region = meccano::approximate_volume(mesh, first, {resolution}, stats);
+    std::vector<std::uint8_t> on_boundary(mesh.points.size(), 0);
+    for (meccano::TetId t = 0; t < mesh.num_tets(); ++t)
+      for (int f = 0; f < 4 && region[t]; ++f) {
+        const meccano::TetId across = mesh.neighbours[t][f];
+        if (across == meccano::no_tet || !region[across])
+          for (int local : meccano::face_vertices[f]) on_boundary[mesh.tets[t][local]] = 1;
+      }
+    double largest = 0, sum = 0;
+    int count = 0;
+    for (meccano::VertexId v = 0; v < mesh.num_vertices(); ++v)
+      if (on_boundary[v]) {
+        const double d = std::sqrt(first.closest_point(mesh.points[v]).squared_distance) / resolution;
+        largest = std::max(largest, d);
+        sum += d;
+        ++count;
+      }
+    std::printf("| %-22s | %8d | %8lld | %9lld | %8lld | %10lld | %8.2f | %8.2f |\n", named.name.c_str(),
+                mesh.num_tets(), static_cast<long long>(stats.tets), static_cast<long long>(stats.tets_intersecting),
+                static_cast<long long>(stats.axis_tets), static_cast<long long>(stats.euler_node_stars), largest,
+                sum / count);
   }
   return 0;
 }

@@ -63,6 +63,10 @@ struct VolumetricStats {
 TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const VolumetricOptions& options,
                              VolumetricStats& stats, std::vector<TetRegion*> other_regions = {});
 
+// Steps 2-3 alone, on any non-empty region: grows it into a ball with axis-parallel boundary faces.
+void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& options, VolumetricStats& stats,
+                    std::vector<TetRegion*> other_regions = {});
+
 struct BallCheck {
   bool nonempty = false;
   bool connected = false;

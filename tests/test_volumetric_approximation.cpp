@@ -76,9 +76,7 @@ void expect_valid_approximation(const TetMesh& mesh, const TriangleSurface& surf
                               << ball.boundary_components << ", boundary Euler " << ball.boundary_euler;
   EXPECT_EQ(ball.non_axis_faces, 0);
 
-  // V_M stays close to S: its growth never pulls in coarse tets. A tet meeting S has its nodes within
-  // l_T < l_r of S; the axis-parallel extension fills the dyadic cube of such a tet (diagonal at most
-  // sqrt(3) l_T), so boundary nodes lie within 2 l_r. (Measured: 0.65 to 1.17 l_r, doc/results.md.)
+  // V_M stays close to S: its growth never pulls in coarse tets or nodes farther than l_r from S.
   for (TetId t = 0; t < mesh.num_tets(); ++t) {
     if (!region[t]) continue;
     for (int f = 0; f < 4; ++f) {
@@ -86,7 +84,7 @@ void expect_valid_approximation(const TetMesh& mesh, const TriangleSurface& surf
       if (across != no_tet && region[across]) continue;
       for (int local : face_vertices[f]) {
         const double distance = std::sqrt(bvh.closest_point(mesh.points[mesh.tets[t][local]]).squared_distance);
-        ASSERT_LT(distance, 2 * resolution) << "boundary node of V_M far from S";
+        ASSERT_LT(distance, resolution) << "boundary node of V_M far from S";
       }
     }
   }

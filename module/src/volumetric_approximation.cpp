@@ -294,22 +294,35 @@ TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const Vo
   }
   stats.tets_intersecting = std::count(region.begin(), region.end(), 1);
   if (stats.tets_intersecting == 0) throw MeshingError("the surface meets no tet of the mesh");
-  grow_into_ball(mesh, region, options, stats, std::move(other_regions));
+  grow_into_ball(mesh, region, options, stats, std::move(other_regions), &surface);
   return region;
 }
 
 void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& options, VolumetricStats& stats,
-                    std::vector<TetRegion*> other_regions) {
+                    std::vector<TetRegion*> other_regions, const TriangleBVH* surface) {
   const ChildCallback follow_others = region_follows_children(std::move(other_regions));
   // Steps 2 and 3: grow into a ball with axis-parallel boundary faces. A tet the growth wants that is
-  // not finer than l_r is bisected instead of added: adding coarse tets would pull far-away, coarse
-  // parts of the mesh into V_M (each brings new oblique faces and pinched nodes further out).
+  // not finer than l_r, or (given S) has a node farther than l_r from S, is bisected instead of added:
+  // adding coarse tets would pull far-away, coarse parts of the mesh into V_M (each brings new oblique
+  // faces and pinched nodes further out), and far nodes would become nodes of S_M far from S.
+  std::vector<std::int8_t> near_surface;  // per vertex: 1 near, 0 far, -1 not computed yet
+  auto too_far = [&](TetId t) {
+    if (!surface) return false;
+    near_surface.resize(mesh.points.size(), -1);
+    for (VertexId v : mesh.tets[t]) {
+      if (near_surface[v] < 0)
+        near_surface[v] = surface->closest_point(mesh.points[v]).squared_distance <
+                          options.resolution * options.resolution;
+      if (!near_surface[v]) return true;
+    }
+    return false;
+  };
   auto grow = [&](const std::vector<TetId>& wanted) -> std::int64_t {
     std::vector<TetId> coarse;
     std::int64_t added = 0;
     for (TetId t : wanted) {
       if (region[t]) continue;
-      if (mesh.longest_edge(t) >= options.resolution) {
+      if (mesh.longest_edge(t) >= options.resolution || too_far(t)) {
         coarse.push_back(t);
       } else {
         region[t] = 1;

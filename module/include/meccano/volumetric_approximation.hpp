@@ -10,8 +10,9 @@
 //             χ = n_E − n_F + n_T = 1, is necessary; the link must also be connected and its triangles
 //             around each link vertex must form one fan (eq. 2 alone accepts pinched links). Cavities
 //             (components of the complement that V_M encloses) are filled.
-//          In steps 2 and 3 a tet to be added whose longest edge is l_r or more is bisected instead
-//          (and the step repeats), so V_M stays made of tets finer than l_r, close to S.
+//          In steps 2 and 3 a tet to be added whose longest edge is l_r or more, or with a node farther
+//          than l_r from S, is bisected instead (and the step repeats), so V_M stays made of tets
+//          finer than l_r with every node within l_r of S.
 //          3. Grow V_M until every boundary face lies on a coordinate plane in computational
 //             coordinates, by adding the tet across each face that does not; step 2 is then re-run,
 //             until neither step changes V_M. If V_M then has disk links everywhere but a boundary
@@ -20,7 +21,8 @@
 // Output   per-tet membership of V_M, and counts of what each step did.
 // Invariants on return (check_ball): V_M is face-connected, every boundary node has a disk link, the
 //          boundary is one closed 2-manifold with Euler characteristic 2, every boundary face is
-//          axis-parallel; every tet meeting S is in V_M and has l_T < l_r.
+//          axis-parallel; every tet meeting S is in V_M and has l_T < l_r; every node of V_M is within
+//          l_r of S.
 // Errors   InputError for l_r <= 0; MeshingError if V_M cannot be made a ball within the pass limit.
 #pragma once
 
@@ -64,8 +66,9 @@ TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const Vo
                              VolumetricStats& stats, std::vector<TetRegion*> other_regions = {});
 
 // Steps 2-3 alone, on any non-empty region: grows it into a ball with axis-parallel boundary faces.
+// Given S, the tets added also keep every node within l_r of S.
 void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& options, VolumetricStats& stats,
-                    std::vector<TetRegion*> other_regions = {});
+                    std::vector<TetRegion*> other_regions = {}, const TriangleBVH* surface = nullptr);
 
 struct BallCheck {
   bool nonempty = false;

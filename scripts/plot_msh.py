@@ -96,6 +96,7 @@ def main():
     parser.add_argument("--surface", action="append", default=[])
     parser.add_argument("--obj")
     parser.add_argument("--title", default="")
+    parser.add_argument("--view", default="28,-60", help="elevation,azimuth in degrees")
     args = parser.parse_args()
 
     nodes, groups = read_msh41(args.mesh)
@@ -118,7 +119,8 @@ def main():
     ax.set_ylim(lo[1], hi[1])
     ax.set_zlim(lo[2], hi[2])
     ax.set_box_aspect(hi - lo)
-    ax.view_init(elev=28, azim=-60)
+    elevation, azimuth = (float(a) for a in args.view.split(","))
+    ax.view_init(elev=elevation, azim=azimuth)
     ax.set_title(args.title)
     fig.tight_layout()
     fig.savefig(args.png, dpi=130)

@@ -155,6 +155,20 @@ TEST_F(CliTest, VolumetricStageWritesOneGroupPerSurface) {
   EXPECT_LT(sizes.at("volumetric_1"), sizes.at("domain"));
 }
 
+TEST_F(CliTest, ApproximationStageWritesOneInterfaceGroupPerSurface) {
+  const auto pair = testing::stacked_pair(8);
+  const std::string lower = write_obj("lower.obj", pair[0]);
+  const std::string upper = write_obj("upper.obj", pair[1]);
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + lower + ":bottom --surface " + upper +
+                             ":top --resolution 0.06 --stage approximation --output " + path("sm.msh"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("approximation bottom: side"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("approximation top: side"), std::string::npos) << run.output;
+  const auto sizes = group_sizes(path("sm.msh"));
+  for (const char* name : {"interface_bottom", "interface_top", "volumetric_bottom", "volumetric_top", "domain"})
+    EXPECT_GT(sizes.count(name) ? sizes.at(name) : 0u, 0u) << name;
+}
+
 TEST_F(CliTest, BadSurfacesFailWithTheirOwnMessageAndWriteNothing) {
   const TriangleSurface patch = testing::paper_like_patch(6);
   TriangleSurface outside = patch;

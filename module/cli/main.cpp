@@ -37,8 +37,11 @@ Options:
                            .msh); NAME defaults to its 1-based position (may repeat)
   --resolution L           l_r: tets meeting a surface are refined until their longest edge is below L
                            (required with --surface)
-  --stage volumetric       stop after this stage and write its result: the refined mesh with the 3D
-                           group volumetric_NAME holding each surface's volumetric approximation
+  --stage STAGE            stop after this stage and write its result, for inspection:
+                           volumetric     the refined mesh with the 3D group volumetric_NAME holding
+                                          each surface's volumetric approximation V_M
+                           approximation  also the 2D group interface_NAME: the healed surface
+                                          approximation S_M (nodes not moved yet)
   --output FILE.msh        Gmsh MSH 4.1 ASCII with the 3D group `domain`, the 2D groups xmin, xmax,
                            ymin, ymax, zmin, zmax, and the groups of the stage (may repeat)
   --quiet                  no progress output
@@ -149,8 +152,8 @@ Options parse_options(int argc, char** argv) {
       options.resolution = l;
     } else if (arg == "--stage") {
       options.stage = value();
-      if (*options.stage != "volumetric")
-        throw UsageError("--stage " + *options.stage + ": the stages available are: volumetric");
+      if (*options.stage != "volumetric" && *options.stage != "approximation")
+        throw UsageError("--stage " + *options.stage + ": the stages available are: volumetric, approximation");
     } else if (arg == "--output" || arg == "-o") {
       options.outputs.push_back(value());
     } else if (arg == "--quiet" || arg == "-q") {
@@ -165,7 +168,7 @@ Options parse_options(int argc, char** argv) {
   if (options.surfaces.empty() && (options.resolution || options.stage))
     throw UsageError("--resolution and --stage need at least one --surface");
   if (!options.surfaces.empty() && !options.stage)
-    throw UsageError("only --stage volumetric is available so far: give it explicitly");
+    throw UsageError("the pipeline stops at --stage approximation so far: give --stage explicitly");
   for (std::size_t i = 0; i < options.surfaces.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (options.surfaces[i].second == options.surfaces[j].second)
@@ -217,6 +220,8 @@ int run(const Options& options) {
 
   meccano::InsertionOptions insertion;
   insertion.resolution = options.resolution.value_or(0.0);
+  insertion.last_stage =
+      options.stage == "approximation" ? meccano::Stage::approximation : meccano::Stage::volumetric;
   insertion.progress = [&progress](const std::string& line) { progress.say(line); };
   const meccano::InsertionResult result = meccano::insert_surfaces(std::move(mesh), surfaces, insertion);
 

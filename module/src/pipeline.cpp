@@ -53,16 +53,65 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
            " axis tets); mesh ", result.mesh.num_tets(), " tets");
   }
   check_stage(result.mesh, "volumetric");
+  if (options.last_stage == Stage::volumetric) return result;
+
+  // Step 2: the surface approximation of each surface, healed. Healing a later surface refines the
+  // mesh near it, which can disturb an earlier S_M close by, so all are checked again and re-healed.
+  std::vector<TriangleBVH> trees;
+  for (const TriangleSurface& surface : surfaces) trees.emplace_back(surface);
+  const int count = static_cast<int>(surfaces.size());
+  auto other_regions = [&](int s) {
+    std::vector<TetRegion*> regions;
+    for (int other = 0; other < count; ++other)
+      if (other != s) regions.push_back(&result.surfaces[other].volumetric);
+    return regions;
+  };
+  for (int round = 0; round < 3; ++round) {
+    bool healed_any = false;
+    for (int s = 0; s < count; ++s) {
+      SurfaceInsertion& inserted = result.surfaces[s];
+      if (round > 0 && check_surface_approximation(result.mesh, inserted.volumetric, s).healed()) continue;
+      const auto start = std::chrono::steady_clock::now();
+      inserted.healing_stats = approximate_surface(result.mesh, inserted.volumetric, surfaces[s], trees[s], s, {}, other_regions(s));
+      inserted.approximation_seconds += seconds_since(start);
+      healed_any = true;
+      const auto& h = inserted.healing_stats;
+      report(options, "approximation ", inserted.name, ": side ", h.side > 0 ? "+" : "-", ", ", h.passes,
+             " healing passes; ", h.faces, " faces, ", h.rim_nodes, " rim nodes; extension ", h.extension_faces,
+             ", corbels ", h.corbels, ", reflex corners filled ", h.reflex_corners_filled, " left ", h.reflex_corners_left,
+             ", tets with two faces ",
+             h.tets_with_two_faces, ", triangles with two rim edges ", h.triangles_with_two_rim_edges,
+             ", cross-surface edges ", h.cross_surface_edges, ", dividing edges ", h.dividing_edges, "; mesh ",
+             result.mesh.num_tets(), " tets");
+    }
+    if (!healed_any) break;
+  }
+  for (int s = 0; s < count; ++s) {
+    const auto check = check_surface_approximation(result.mesh, result.surfaces[s].volumetric, s);
+    if (!check.healed())
+      throw MeshingError("the surface approximation of " + result.surfaces[s].name +
+                         " is disturbed by the other surfaces: " + check.describe());
+  }
+  check_stage(result.mesh, "approximation");
   return result;
 }
 
 MeshGroups output_groups(const InsertionResult& result) {
-  MeshGroups groups = standard_groups(result.mesh);
-  for (const SurfaceInsertion& inserted : result.surfaces) {
-    TetGroup group{"volumetric_" + inserted.name, {}};
+  MeshGroups groups;
+  const MeshGroups standard = standard_groups(result.mesh);
+  groups.volumes = standard.volumes;
+  for (const FaceGroup& group : standard.surfaces)
+    if (group.name.rfind("interface_", 0) != 0) groups.surfaces.push_back(group);  // box sides
+  for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s) {
+    const SurfaceInsertion& inserted = result.surfaces[s];
+    TetGroup volume{"volumetric_" + inserted.name, {}};
     for (TetId t = 0; t < result.mesh.num_tets(); ++t)
-      if (inserted.volumetric[t]) group.tets.push_back(t);
-    groups.volumes.push_back(std::move(group));
+      if (inserted.volumetric[t]) volume.tets.push_back(t);
+    groups.volumes.push_back(std::move(volume));
+    if (inserted.healing_stats.side != 0)
+      groups.surfaces.push_back(
+          {"interface_" + inserted.name,
+           interface_faces(result.mesh, inserted.volumetric, s, inserted.healing_stats.side).faces});
   }
   return groups;
 }

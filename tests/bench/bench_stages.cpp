@@ -1,14 +1,16 @@
-// Volumetric approximation benchmark (paper §4.1): the cube example's surface (the paper-like patch,
+// Benchmark and measurements of the first two stages. Volumetric approximation (paper §4.1): the cube example's surface (the paper-like patch,
 // 96 x 96 grid, 18 432 triangles) inserted into the unit-cube meccano for l_r from 1/16 to 1/256 of the
 // box size. Prints a Markdown table: seconds of the stage (best of the repetitions), tets tested for
 // intersection per second, refinement passes, final mesh size and V_M size.
 //
 // A second table measures, for every test surface at l_r = 1/32, what the growth into a ball did and
-// how far the boundary nodes of V_M are from S, in units of l_r.
+// how far the boundary nodes of V_M are from S, in units of l_r. A third heals S_M on each and counts
+// what every rule did, S_M's size against S, and the time.
 //
-// Usage: bench_volumetric [--repeat N] [--finest K]   (l_r down to 1/2^K, default K = 8)
+// Usage: bench_stages [--repeat N] [--finest K]   (l_r down to 1/2^K, default K = 8)
 
 #include <meccano/cube_meccano.hpp>
+#include <meccano/surface_approximation.hpp>
 #include <meccano/volumetric_approximation.hpp>
 
 #include <test_surfaces.hpp>
@@ -80,6 +82,38 @@ int main(int argc, char** argv) {
                 mesh.num_tets(), static_cast<long long>(stats.tets), static_cast<long long>(stats.tets_intersecting),
                 static_cast<long long>(stats.axis_tets), static_cast<long long>(stats.euler_node_stars), largest,
                 sum / count);
+  }
+
+  std::printf("\n| %-22s | %6s | %6s | %5s | %6s | %5s | %5s | %5s | %6s | %5s | %5s | %5s | %7s | %6s |\n",
+              "S_M (l_r = 1/32)", "faces", "passes", "ext", "corbel", "fill", "left", "2face", "2rim",
+              "div", "cross", "max d", "S_M/S", "ms");
+  std::printf("|------------------------|--------|--------|-------|--------|-------|-------|-------|--------|-------|-------|-------|---------|--------|\n");
+  for (const auto& named : meccano::testing::named_test_surfaces(24)) {
+    meccano::TetMesh mesh = meccano::make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
+    const meccano::TriangleSurface& patch = named.surfaces.front();
+    const meccano::TriangleBVH patch_tree(patch);
+    meccano::VolumetricStats stats;
+    meccano::TetRegion region = meccano::approximate_volume(mesh, patch_tree, {resolution}, stats);
+    const auto start = std::chrono::steady_clock::now();
+    const meccano::HealingStats h = meccano::approximate_surface(mesh, region, patch, patch_tree, 0);
+    const double ms = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() * 1e3;
+    const auto faces = meccano::interface_faces(mesh, region, 0, h.side);
+    auto area_of = [](const auto& points, const auto& triangles) {
+      double area = 0;
+      for (const auto& t : triangles) area += 0.5 * (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]).norm();
+      return area;
+    };
+    double largest = 0;
+    for (const auto& t : faces.triangles)
+      for (meccano::VertexId v : t)
+        largest = std::max(largest, std::sqrt(patch_tree.closest_point(mesh.points[v]).squared_distance));
+    std::printf("| %-22s | %6lld | %6d | %5lld | %6lld | %5lld | %5lld | %5lld | %6lld | %5lld | %5lld | %5.2f | %7.2f | %6.1f |\n",
+                named.name.c_str(), static_cast<long long>(h.faces), h.passes,
+                static_cast<long long>(h.extension_faces), static_cast<long long>(h.corbels),
+                static_cast<long long>(h.reflex_corners_filled), static_cast<long long>(h.reflex_corners_left),
+                static_cast<long long>(h.tets_with_two_faces), static_cast<long long>(h.triangles_with_two_rim_edges),
+                static_cast<long long>(h.dividing_edges), static_cast<long long>(h.cross_surface_edges),
+                largest / resolution, area_of(mesh.points, faces.triangles) / area_of(patch.points, patch.triangles), ms);
   }
   return 0;
 }

@@ -2,7 +2,9 @@
 //
 // Input    a meccano mesh (cube_meccano.hpp), surfaces that passed validate_surfaces, and options.
 // Steps    1. volumetric approximation V_M of each surface (volumetric_approximation.hpp);
-//          2-4. surface approximation and healing, projection, smoothing: not implemented yet.
+//          2. surface approximation S_M of each surface, healed (surface_approximation.hpp); once all
+//             are built, any S_M that a later surface's refinement disturbed is healed again;
+//          3-4. projection and smoothing: not implemented yet.
 //          The surfaces are taken one after the other; a later surface's refinement keeps the earlier
 //          surfaces' regions in step (bisection does not change a region's point set).
 // Output   the refined mesh, each surface's V_M, per-stage statistics and timings.
@@ -11,6 +13,7 @@
 
 #include <meccano/mesh_io.hpp>
 #include <meccano/surface.hpp>
+#include <meccano/surface_approximation.hpp>
 #include <meccano/tet_mesh.hpp>
 #include <meccano/volumetric_approximation.hpp>
 
@@ -21,7 +24,7 @@
 
 namespace meccano {
 
-enum class Stage { volumetric };
+enum class Stage { volumetric, approximation };
 
 struct InsertionOptions {
   double resolution = 0.0;  // l_r, a length in physical units
@@ -34,6 +37,8 @@ struct SurfaceInsertion {
   TetRegion volumetric;  // V_M, one flag per tet of the final mesh
   VolumetricStats volumetric_stats;
   double volumetric_seconds = 0.0;
+  HealingStats healing_stats;  // of the last healing of this surface's S_M
+  double approximation_seconds = 0.0;
 };
 
 struct InsertionResult {
@@ -43,7 +48,8 @@ struct InsertionResult {
 
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options);
 
-// `domain`, the box sides, and `volumetric_NAME` for every surface's V_M.
+// `domain`, the box sides, `volumetric_NAME` for every surface's V_M, and `interface_NAME` for every
+// surface's S_M (once built), oriented like the surface.
 MeshGroups output_groups(const InsertionResult& result);
 
 }  // namespace meccano

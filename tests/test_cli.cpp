@@ -1,6 +1,7 @@
 // The meccano-immerse command line: exit statuses, messages, outputs read back by the Gmsh library,
 // and bad input that must fail with its own message and leave no file behind.
 
+#include <meccano/geometry.hpp>
 #include <meccano/surface.hpp>
 
 #include <test_surfaces.hpp>
@@ -167,6 +168,37 @@ TEST_F(CliTest, ApproximationStageWritesOneInterfaceGroupPerSurface) {
   const auto sizes = group_sizes(path("sm.msh"));
   for (const char* name : {"interface_bottom", "interface_top", "volumetric_bottom", "volumetric_top", "domain"})
     EXPECT_GT(sizes.count(name) ? sizes.at(name) : 0u, 0u) << name;
+}
+
+TEST_F(CliTest, ProjectionStageWritesTheInterfaceOnTheSurface) {
+  const TriangleSurface patch = testing::paper_like_patch(12);
+  const std::string file = write_obj("patch.obj", patch);
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + file + " --resolution 0.07 --stage projection --output " +
+                             path("projected.msh"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("projection 1:"), std::string::npos) << run.output;
+  // Every node of the interface group, read back by Gmsh, lies on the surface.
+  gmsh::initialize();
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::open(path("projected.msh"));
+  gmsh::vectorpair groups;
+  gmsh::model::getPhysicalGroups(groups, 2);
+  std::size_t checked = 0;
+  const TriangleBVH tree(patch);
+  for (const auto& [dim, tag] : groups) {
+    std::string name;
+    gmsh::model::getPhysicalName(dim, tag, name);
+    if (name != "interface_1") continue;
+    std::vector<std::size_t> nodes;
+    std::vector<double> coords;
+    gmsh::model::mesh::getNodesForPhysicalGroup(dim, tag, nodes, coords);
+    for (std::size_t i = 0; i < nodes.size(); ++i, ++checked) {
+      const Eigen::Vector3d x(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]);
+      EXPECT_LT(std::sqrt(tree.closest_point(x).squared_distance), 1e-12);
+    }
+  }
+  gmsh::finalize();
+  EXPECT_GT(checked, 0u) << "no interface_1 group";
 }
 
 TEST_F(CliTest, BadSurfacesFailWithTheirOwnMessageAndWriteNothing) {

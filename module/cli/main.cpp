@@ -42,6 +42,8 @@ Options:
                                           each surface's volumetric approximation V_M
                            approximation  also the 2D group interface_NAME: the healed surface
                                           approximation S_M (nodes not moved yet)
+                           projection     S_M's nodes moved onto the surfaces; tets may be inverted
+                                          (this output only: smoothing is not implemented yet)
   --output FILE.msh        Gmsh MSH 4.1 ASCII with the 3D group `domain`, the 2D groups xmin, xmax,
                            ymin, ymax, zmin, zmax, and the groups of the stage (may repeat)
   --quiet                  no progress output
@@ -152,8 +154,9 @@ Options parse_options(int argc, char** argv) {
       options.resolution = l;
     } else if (arg == "--stage") {
       options.stage = value();
-      if (*options.stage != "volumetric" && *options.stage != "approximation")
-        throw UsageError("--stage " + *options.stage + ": the stages available are: volumetric, approximation");
+      if (*options.stage != "volumetric" && *options.stage != "approximation" && *options.stage != "projection")
+        throw UsageError("--stage " + *options.stage +
+                         ": the stages available are: volumetric, approximation, projection");
     } else if (arg == "--output" || arg == "-o") {
       options.outputs.push_back(value());
     } else if (arg == "--quiet" || arg == "-q") {
@@ -168,7 +171,7 @@ Options parse_options(int argc, char** argv) {
   if (options.surfaces.empty() && (options.resolution || options.stage))
     throw UsageError("--resolution and --stage need at least one --surface");
   if (!options.surfaces.empty() && !options.stage)
-    throw UsageError("the pipeline stops at --stage approximation so far: give --stage explicitly");
+    throw UsageError("the pipeline stops at --stage projection so far: give --stage explicitly");
   for (std::size_t i = 0; i < options.surfaces.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (options.surfaces[i].second == options.surfaces[j].second)
@@ -220,12 +223,14 @@ int run(const Options& options) {
 
   meccano::InsertionOptions insertion;
   insertion.resolution = options.resolution.value_or(0.0);
-  insertion.last_stage =
-      options.stage == "approximation" ? meccano::Stage::approximation : meccano::Stage::volumetric;
+  insertion.last_stage = options.stage == "projection"      ? meccano::Stage::projection
+                         : options.stage == "approximation" ? meccano::Stage::approximation
+                                                            : meccano::Stage::volumetric;
   insertion.progress = [&progress](const std::string& line) { progress.say(line); };
   const meccano::InsertionResult result = meccano::insert_surfaces(std::move(mesh), surfaces, insertion);
 
-  const auto check = meccano::verify_mesh(result.mesh);
+  // A tangled mesh is written only as the projection stage's inspection output.
+  const auto check = meccano::verify_mesh(result.mesh, {.physical = insertion.last_stage != meccano::Stage::projection});
   if (!check.ok()) throw meccano::MeshingError("the mesh fails its invariant checks: " + check.summary());
 
   const auto groups = meccano::output_groups(result);

@@ -93,6 +93,22 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
                          " is disturbed by the other surfaces: " + check.describe());
   }
   check_stage(result.mesh, "approximation");
+  if (options.last_stage == Stage::approximation) return result;
+
+  // Step 3: every S_M node moves onto its surface. Tets may be tangled until step 4.
+  for (int s = 0; s < count; ++s) {
+    SurfaceInsertion& inserted = result.surfaces[s];
+    const auto start = std::chrono::steady_clock::now();
+    inserted.projection = project_onto_surface(result.mesh, inserted.volumetric, s, inserted.healing_stats.side,
+                                               surfaces[s], trees[s]);
+    inserted.projection_seconds = seconds_since(start);
+    const auto& p = inserted.projection.stats;
+    report(options, "projection ", inserted.name, ": ", p.nodes, " nodes (", p.rim_nodes, " on the rim) moved by up to ",
+           p.largest_move, ", now within ", p.largest_distance_after, " of S; ", p.inverted_tets,
+           " tets inverted (smoothing untangles them)");
+  }
+  const auto check = verify_mesh(result.mesh, {.physical = false});
+  if (!check.ok()) throw MeshingError("mesh invalid after the projection stage: " + check.summary());
   return result;
 }
 

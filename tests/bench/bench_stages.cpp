@@ -5,11 +5,14 @@
 //
 // A second table measures, for every test surface at l_r = 1/32, what the growth into a ball did and
 // how far the boundary nodes of V_M are from S, in units of l_r. A third heals S_M on each and counts
-// what every rule did, S_M's size against S, and the time.
+// what every rule did, S_M's size against S, and the time. A fourth projects S_M onto S for the cube
+// example at l_r = 1/8 ... 1/64 and gives the Hausdorff distance between S and the projected S_M (on
+// vertices and centroids) with its rate per halving, the largest node move and the inverted tets.
 //
 // Usage: bench_stages [--repeat N] [--finest K]   (l_r down to 1/2^K, default K = 8)
 
 #include <meccano/cube_meccano.hpp>
+#include <meccano/projection.hpp>
 #include <meccano/surface_approximation.hpp>
 #include <meccano/volumetric_approximation.hpp>
 
@@ -114,6 +117,43 @@ int main(int argc, char** argv) {
                 static_cast<long long>(h.tets_with_two_faces), static_cast<long long>(h.triangles_with_two_rim_edges),
                 static_cast<long long>(h.dividing_edges), static_cast<long long>(h.cross_surface_edges),
                 largest / resolution, area_of(mesh.points, faces.triangles) / area_of(patch.points, patch.triangles), ms);
+  }
+
+  std::printf("\n| %8s | %8s | %10s | %6s | %12s | %14s | %10s |\n", "l_r", "S_M faces", "Hausdorff", "rate",
+              "largest move", "inverted tets", "ms");
+  std::printf("|----------|----------|------------|--------|--------------|----------------|------------|\n");
+  const meccano::TriangleSurface& example = surface;
+  double previous = 0;
+  for (int k = 3; k <= 6; ++k) {
+    const double l_r = 1.0 / (1 << k);
+    meccano::TetMesh mesh = meccano::make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
+    meccano::VolumetricStats stats;
+    meccano::TetRegion region = meccano::approximate_volume(mesh, tree, {l_r}, stats);
+    const meccano::HealingStats h = meccano::approximate_surface(mesh, region, example, tree, 0);
+    const auto start = std::chrono::steady_clock::now();
+    const auto projection = meccano::project_onto_surface(mesh, region, 0, h.side, example, tree);
+    const double ms = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() * 1e3;
+    meccano::TriangleSurface projected;
+    projected.points = mesh.points;
+    for (const auto& t : meccano::interface_faces(mesh, region, 0, h.side).triangles)
+      projected.triangles.push_back({t[0], t[1], t[2]});
+    const meccano::TriangleBVH projected_tree(projected);
+    double hausdorff = 0;
+    auto one_way = [&](const meccano::TriangleSurface& from, const meccano::TriangleBVH& to) {
+      for (const auto& t : from.triangles) {
+        for (int c = 0; c < 3; ++c)
+          hausdorff = std::max(hausdorff, std::sqrt(to.closest_point(from.points[t[c]]).squared_distance));
+        const Eigen::Vector3d centroid = (from.points[t[0]] + from.points[t[1]] + from.points[t[2]]) / 3;
+        hausdorff = std::max(hausdorff, std::sqrt(to.closest_point(centroid).squared_distance));
+      }
+    };
+    one_way(example, projected_tree);
+    one_way(projected, tree);
+    const double rate = previous > 0 ? std::log2(previous / hausdorff) : 0.0;
+    std::printf("| 1/%-6d | %8zu | %10.3e | %6s | %12.4f | %14lld | %10.1f |\n", 1 << k, projected.triangles.size(),
+                hausdorff, previous > 0 ? std::to_string(rate).substr(0, 4).c_str() : "", projection.stats.largest_move,
+                static_cast<long long>(projection.stats.inverted_tets), ms);
+    previous = hausdorff;
   }
   return 0;
 }

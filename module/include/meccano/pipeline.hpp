@@ -4,7 +4,8 @@
 // Steps    1. volumetric approximation V_M of each surface (volumetric_approximation.hpp);
 //          2. surface approximation S_M of each surface, healed (surface_approximation.hpp); once all
 //             are built, any S_M that a later surface's refinement disturbed is healed again;
-//          3-4. projection and smoothing: not implemented yet.
+//          3. projection of each S_M onto its surface (projection.hpp);
+//          4. smoothing: not implemented yet (the projected mesh is usually tangled).
 //          The surfaces are taken one after the other; a later surface's refinement keeps the earlier
 //          surfaces' regions in step (bisection does not change a region's point set).
 // Output   the refined mesh, each surface's V_M, per-stage statistics and timings.
@@ -12,6 +13,7 @@
 #pragma once
 
 #include <meccano/mesh_io.hpp>
+#include <meccano/projection.hpp>
 #include <meccano/surface.hpp>
 #include <meccano/surface_approximation.hpp>
 #include <meccano/tet_mesh.hpp>
@@ -24,7 +26,7 @@
 
 namespace meccano {
 
-enum class Stage { volumetric, approximation };
+enum class Stage { volumetric, approximation, projection };
 
 struct InsertionOptions {
   double resolution = 0.0;  // l_r, a length in physical units
@@ -39,6 +41,8 @@ struct SurfaceInsertion {
   double volumetric_seconds = 0.0;
   HealingStats healing_stats;  // of the last healing of this surface's S_M
   double approximation_seconds = 0.0;
+  SurfaceProjection projection;
+  double projection_seconds = 0.0;
 };
 
 struct InsertionResult {

@@ -1,0 +1,48 @@
+// Step 3 of the method (paper §4.3): every node of S_M moves onto S, x_i = φ(φ_M^{-1}(x_Mi)).
+//
+// Input    the mesh, the index and side of a healed S_M (surface_approximation.hpp), and S.
+// Steps    1. S and S_M (its faces oriented like S) are parameterized onto P = [0,1]^2 with Floater's
+//             weights (parameterization.hpp); S_M's weights are taken with its nodes pulled 80 % of the
+//             way onto S, so that the two parameterizations nearly agree (see projection.cpp). S's corners are chosen along its rim by arc length (natural
+//             corners kept); S_M's are the rim nodes closest to them, in the same cyclic order around the
+//             same mean normal, so φ ∘ φ_M^{-1} does not twist.
+//          2. Each S_M node's own parameters u = φ_M^{-1}(x_M) are located in S's parametric triangulation
+//             and the node moves to φ(u). Rim nodes land on the rim of S, corners on its corners.
+// Output   the moved mesh (tets may be tangled: step 4 untangles them), the parameterizations, and
+//          statistics: how far nodes moved, how far they are from S afterwards, inverted tets.
+// Errors   MeshingError from the parameterization (rim not one loop, corners impossible, map not
+//          one-to-one).
+#pragma once
+
+#include <meccano/geometry.hpp>
+#include <meccano/parameterization.hpp>
+#include <meccano/surface.hpp>
+#include <meccano/tet_mesh.hpp>
+#include <meccano/volumetric_approximation.hpp>
+
+#include <memory>
+
+namespace meccano {
+
+struct ProjectionStats {
+  std::int64_t nodes = 0;              // S_M nodes moved
+  std::int64_t rim_nodes = 0;
+  double largest_move = 0.0;           // physical distance, x_i - x_Mi
+  double largest_distance_after = 0.0; // of a moved node to S (round-off)
+  std::int64_t inverted_tets = 0;      // after the move, before smoothing
+};
+
+// What step 4 needs to move S_M nodes within S: φ, and each S_M node's parameters.
+struct SurfaceProjection {
+  std::unique_ptr<ParametricSurface> surface;  // φ: P -> S
+  std::vector<VertexId> nodes;                 // the S_M nodes
+  std::vector<Eigen::Vector2d> uv;             // their parameters (same order)
+  std::vector<std::uint8_t> on_rim;            // same order
+  ProjectionStats stats;
+};
+
+SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,
+                                       const TriangleSurface& surface, const TriangleBVH& tree,
+                                       FloaterWeights weights = FloaterWeights::mean_value);
+
+}  // namespace meccano

@@ -3,6 +3,8 @@
 #include <meccano/bisection.hpp>
 #include <meccano/error.hpp>
 
+#include "topology_helpers.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -11,8 +13,9 @@
 namespace meccano {
 namespace {
 
-using Edge = std::pair<VertexId, VertexId>;
-Edge make_edge(VertexId a, VertexId b) { return a < b ? Edge{a, b} : Edge{b, a}; }
+using detail::Edge;
+using detail::make_edge;
+using detail::UnionFind;
 
 bool edge_is_axis_parallel(const TetMesh& mesh, VertexId a, VertexId b) {
   int differing = 0;
@@ -54,18 +57,6 @@ std::array<VertexId, 3> face_nodes(const TetMesh& mesh, TetId t, int f) {
   return {v[face_vertices[f][0]], v[face_vertices[f][1]], v[face_vertices[f][2]]};
 }
 
-class UnionFind {
- public:
-  explicit UnionFind(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-  std::size_t find(std::size_t i) {
-    while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
-    return i;
-  }
-  void join(std::size_t a, std::size_t b) { parent_[find(a)] = find(b); }
-
- private:
-  std::vector<std::size_t> parent_;
-};
 
 // Labels of the components of a set of faces joined across shared edges (only edges whose two faces
 // both pass `joined`), and the label of the largest.

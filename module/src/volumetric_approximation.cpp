@@ -2,6 +2,8 @@
 
 #include <meccano/error.hpp>
 
+#include "topology_helpers.hpp"
+
 #include <algorithm>
 #include <numeric>
 #include <string>
@@ -9,30 +11,10 @@
 namespace meccano {
 namespace {
 
-class UnionFind {
- public:
-  explicit UnionFind(int n) { reset(n); }
-  void reset(int n) {
-    parent_.resize(static_cast<std::size_t>(n));
-    std::iota(parent_.begin(), parent_.end(), 0);
-  }
-  int find(int i) {
-    while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
-    return i;
-  }
-  void join(int a, int b) { parent_[find(a)] = find(b); }
-  int components() {
-    int count = 0;
-    for (int i = 0; i < static_cast<int>(parent_.size()); ++i) count += find(i) == i;
-    return count;
-  }
 
- private:
-  std::vector<int> parent_;
-};
-
-using Edge = std::pair<VertexId, VertexId>;
-Edge make_edge(VertexId a, VertexId b) { return a < b ? Edge{a, b} : Edge{b, a}; }
+using detail::Edge;
+using detail::make_edge;
+using detail::UnionFind;
 
 // Whether the link of `node` in the region is a disk: the triangles opposite `node` in the region's
 // tets around it must be connected, have Euler characteristic 1 (eq. 2: n_E - n_F + n_T counts the
@@ -423,7 +405,7 @@ BallCheck boundary_topology(const TetMesh& mesh, const TetRegion& region, std::v
   std::sort(edges.begin(), edges.end());
   std::sort(vertices.begin(), vertices.end());
   vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-  UnionFind components(static_cast<int>(faces.size()));
+  UnionFind components(faces.size());
   std::int64_t distinct_edges = 0;
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i + 1;

@@ -15,33 +15,7 @@
 namespace meccano {
 namespace {
 
-struct Case {
-  std::string name;
-  std::vector<TriangleSurface> surfaces;
-  Box box;
-  double resolution;
-};
-
-std::vector<Case> cases() {
-  std::vector<Case> all;
-  const Box unit{{0, 0, 0}, {1, 1, 1}};
-  const Box bar{{-1, 0, 0}, {1, 1, 1}};
-  const Box slab{{0, 0, 0}, {1, 1.5, 0.5}};
-  for (auto& named : testing::named_test_surfaces(16)) {
-    all.push_back({named.name + "_unit_cube_lr16", named.surfaces, unit, 1.0 / 16});
-    all.push_back({named.name + "_unit_cube_lr32", named.surfaces, unit, 1.0 / 32});
-    std::vector<TriangleSurface> in_bar, in_slab, perturbed;
-    for (const auto& s : named.surfaces) {
-      in_bar.push_back(testing::scaled_into(s, bar));
-      in_slab.push_back(testing::scaled_into(s, slab));
-      perturbed.push_back(testing::perturbed(s, 0.2, 7));
-    }
-    all.push_back({named.name + "_2x1x1_box_lr16", in_bar, bar, 1.0 / 16});
-    all.push_back({named.name + "_flat_box_lr40", in_slab, slab, 1.0 / 40});
-    all.push_back({named.name + "_perturbed_lr24", perturbed, unit, 1.0 / 24});
-  }
-  return all;
-}
+using Case = testing::SurfaceCase;
 
 class SurfaceApproximationOn : public ::testing::TestWithParam<Case> {};
 
@@ -99,7 +73,7 @@ TEST_P(SurfaceApproximationOn, IsAHealedDiskCloseToSAndOrientedLikeIt) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllSurfacesAndBoxes, SurfaceApproximationOn, ::testing::ValuesIn(cases()),
+INSTANTIATE_TEST_SUITE_P(AllSurfacesAndBoxes, SurfaceApproximationOn, ::testing::ValuesIn(testing::surface_cases(16, true)),
                          [](const ::testing::TestParamInfo<Case>& param) { return param.param.name; });
 
 TEST(SurfaceApproximation, HealingStatisticsCountTheRules) {

@@ -107,31 +107,7 @@ void expect_valid_approximation(const TetMesh& mesh, const TriangleSurface& surf
   }
 }
 
-struct Case {
-  std::string name;
-  std::vector<TriangleSurface> surfaces;
-  Box box;
-  double resolution;
-};
-
-std::vector<Case> cases() {
-  std::vector<Case> all;
-  const Box unit{{0, 0, 0}, {1, 1, 1}};
-  const Box bar{{-1, 0, 0}, {1, 1, 1}};
-  const Box slab{{0, 0, 0}, {1, 1.5, 0.5}};
-  for (auto& named : testing::named_test_surfaces(16)) {
-    all.push_back({named.name + "_unit_cube_lr16", named.surfaces, unit, 1.0 / 16});
-    all.push_back({named.name + "_unit_cube_lr32", named.surfaces, unit, 1.0 / 32});
-    std::vector<TriangleSurface> in_bar, in_slab;
-    for (const auto& s : named.surfaces) {
-      in_bar.push_back(testing::scaled_into(s, bar));
-      in_slab.push_back(testing::scaled_into(s, slab));
-    }
-    all.push_back({named.name + "_2x1x1_box_lr16", in_bar, bar, 1.0 / 16});
-    all.push_back({named.name + "_flat_box_lr40", in_slab, slab, 1.0 / 40});
-  }
-  return all;
-}
+using Case = testing::SurfaceCase;
 
 class VolumetricOnSurface : public ::testing::TestWithParam<Case> {};
 
@@ -157,7 +133,7 @@ TEST_P(VolumetricOnSurface, IsABallContainingSWithFineTetsNearS) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllSurfacesAndBoxes, VolumetricOnSurface, ::testing::ValuesIn(cases()),
+INSTANTIATE_TEST_SUITE_P(AllSurfacesAndBoxes, VolumetricOnSurface, ::testing::ValuesIn(testing::surface_cases(16, false)),
                          [](const ::testing::TestParamInfo<Case>& param) { return param.param.name; });
 
 TEST(VolumetricApproximation, PerturbedSurfacesGiveBallsToo) {

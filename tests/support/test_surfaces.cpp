@@ -202,4 +202,25 @@ TriangleSurface scaled_into(TriangleSurface surface, const Box& box) {
   return surface;
 }
 
+std::vector<SurfaceCase> surface_cases(int n, bool with_perturbed) {
+  std::vector<SurfaceCase> all;
+  const Box unit{{0, 0, 0}, {1, 1, 1}};
+  const Box bar{{-1, 0, 0}, {1, 1, 1}};
+  const Box slab{{0, 0, 0}, {1, 1.5, 0.5}};
+  for (auto& named : named_test_surfaces(n)) {
+    all.push_back({named.name + "_unit_cube_lr16", named.surfaces, unit, 1.0 / 16});
+    all.push_back({named.name + "_unit_cube_lr32", named.surfaces, unit, 1.0 / 32});
+    std::vector<TriangleSurface> in_bar, in_slab, moved;
+    for (const auto& s : named.surfaces) {
+      in_bar.push_back(scaled_into(s, bar));
+      in_slab.push_back(scaled_into(s, slab));
+      moved.push_back(perturbed(s, 0.2, 7));
+    }
+    all.push_back({named.name + "_2x1x1_box_lr16", in_bar, bar, 1.0 / 16});
+    all.push_back({named.name + "_flat_box_lr40", in_slab, slab, 1.0 / 40});
+    if (with_perturbed) all.push_back({named.name + "_perturbed_lr24", moved, unit, 1.0 / 24});
+  }
+  return all;
+}
+
 }  // namespace meccano::testing

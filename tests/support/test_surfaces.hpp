@@ -40,6 +40,18 @@ struct NamedSurfaces {
 // patch (irregular triangles).
 std::vector<NamedSurfaces> named_test_surfaces(int n);
 
+// A case of the stage tests: surfaces (inserted in order) in a box at a resolution.
+struct SurfaceCase {
+  std::string name;  // a valid test name: letters, digits, '_'
+  std::vector<TriangleSurface> surfaces;
+  Box box;
+  double resolution;
+};
+
+// Every entry of named_test_surfaces(n) in the unit cube at l_r = 1/16 and 1/32, in a 2x1x1 box at 1/16
+// and in a flat 1 x 1.5 x 0.5 box at 1/40; with `perturbed`, also perturbed (seed 7) at 1/24.
+std::vector<SurfaceCase> surface_cases(int n, bool with_perturbed);
+
 // Moves every vertex not on the rim by a random tangential offset of length at most amplitude times
 // the shortest edge at that vertex (deterministic for a seed on every platform). amplitude <= 0.25
 // keeps every triangle valid.

@@ -15,6 +15,9 @@ namespace {
 
 using detail::Edge;
 using detail::make_edge;
+using detail::TopologyScratch;
+using detail::triangle_topology;
+using detail::TriangleTopology;
 using detail::UnionFind;
 
 bool edge_is_axis_parallel(const TetMesh& mesh, VertexId a, VertexId b) {
@@ -401,36 +404,12 @@ class EdgeSplitter {
 void check_disk(const TetMesh& mesh, const Interface& s, SurfaceApproximationCheck& c) {
   c.faces = static_cast<std::int64_t>(s.faces.size());
   if (s.faces.empty()) return;
-  const auto label = edge_components(s.nodes, [](std::size_t, std::size_t) { return true; });
-  c.connected = std::all_of(label.begin(), label.end(), [&](std::size_t l) { return l == label[0]; });
-  std::int64_t edges = 0;
-  for (std::size_t i = 0; i < s.edge_faces.size();) {
-    std::size_t j = i + 1;
-    while (j < s.edge_faces.size() && s.edge_faces[j].first == s.edge_faces[i].first) ++j;
-    ++edges;
-    c.non_manifold_edges += j - i > 2;
-    i = j;
-  }
-  // Per node: faces minus interior edges is the number of open fans (1 on the rim, 0 inside).
-  std::vector<std::pair<VertexId, int>> fans;
-  for (const auto& f : s.nodes)
-    for (VertexId v : f) fans.push_back({v, 1});
-  for (std::size_t i = 0; i + 1 < s.edge_faces.size(); ++i)
-    if (s.edge_faces[i].first == s.edge_faces[i + 1].first) {
-      fans.push_back({s.edge_faces[i].first.first, -1});
-      fans.push_back({s.edge_faces[i].first.second, -1});
-    }
-  std::sort(fans.begin(), fans.end());
-  std::int64_t nodes = 0;
-  for (std::size_t i = 0; i < fans.size();) {
-    std::size_t j = i;
-    int open = 0;
-    while (j < fans.size() && fans[j].first == fans[i].first) open += fans[j++].second;
-    ++nodes;
-    c.pinched_nodes += open > 1;
-    i = j;
-  }
-  c.euler = nodes - edges + static_cast<std::int64_t>(s.faces.size());
+  TopologyScratch scratch;
+  const TriangleTopology topology = triangle_topology(s.nodes, scratch);
+  c.connected = topology.components == 1;
+  c.non_manifold_edges = topology.overloaded_edges;
+  c.pinched_nodes = topology.pinched_vertices;
+  c.euler = topology.euler();
   // Rim loops: components of the rim edges.
   std::vector<VertexId> rim_nodes;
   for (const Edge& e : s.rim_edges) rim_nodes.insert(rim_nodes.end(), {e.first, e.second});

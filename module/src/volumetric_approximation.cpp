@@ -12,9 +12,9 @@ namespace meccano {
 namespace {
 
 
-using detail::Edge;
-using detail::make_edge;
-using detail::UnionFind;
+using detail::TopologyScratch;
+using detail::triangle_topology;
+using detail::TriangleTopology;
 
 // Whether the link of `node` in the region is a disk: the triangles opposite `node` in the region's
 // tets around it must be connected, have Euler characteristic 1 (eq. 2: n_E - n_F + n_T counts the
@@ -24,19 +24,13 @@ using detail::UnionFind;
 // when i = d and d - i open fans otherwise. `scratch` is reused between calls to avoid allocation.
 struct LinkScratch {
   std::vector<std::array<VertexId, 3>> triangles;
-  std::vector<std::pair<Edge, int>> edges;  // (edge, triangle)
-  std::vector<std::pair<VertexId, int>> vertex_counts;  // (vertex, triangles - interior edges)
-  UnionFind components{0};
+  TopologyScratch topology;
 };
 
 bool link_is_disk(const TetMesh& mesh, const TetRegion& region, const VertexTets& incidence, VertexId node,
                   LinkScratch& scratch) {
   auto& triangles = scratch.triangles;
-  auto& edges = scratch.edges;
-  auto& counts = scratch.vertex_counts;
   triangles.clear();
-  edges.clear();
-  counts.clear();
   for (TetId t : incidence.of(node)) {
     if (!region[t]) continue;
     std::array<VertexId, 3> opposite{};
@@ -45,45 +39,10 @@ bool link_is_disk(const TetMesh& mesh, const TetRegion& region, const VertexTets
       if (v != node) opposite[k++] = v;
     triangles.push_back(opposite);
   }
-  const int n = static_cast<int>(triangles.size());
-  if (n == 0) return false;
-  for (int i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) {
-      edges.push_back({make_edge(triangles[i][k], triangles[i][(k + 1) % 3]), i});
-      counts.push_back({triangles[i][k], 1});
-    }
-  std::sort(edges.begin(), edges.end());
-
-  std::int64_t distinct_edges = 0;
-  bool has_boundary = false;
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i + 1;
-    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
-    ++distinct_edges;
-    if (j - i == 1) has_boundary = true;
-    if (j - i == 2) {  // an interior edge: one less open fan at each of its ends
-      counts.push_back({edges[i].first.first, -1});
-      counts.push_back({edges[i].first.second, -1});
-    }
-    i = j;
-  }
-  // Connectivity of the triangles across shared edges.
-  scratch.components.reset(n);
-  for (std::size_t i = 0; i + 1 < edges.size(); ++i)
-    if (edges[i].first == edges[i + 1].first) scratch.components.join(edges[i].second, edges[i + 1].second);
-  if (scratch.components.components() != 1) return false;
-
-  std::sort(counts.begin(), counts.end());
-  std::int64_t vertices = 0;
-  for (std::size_t i = 0; i < counts.size();) {
-    std::size_t j = i;
-    int open_fans = 0;
-    while (j < counts.size() && counts[j].first == counts[i].first) open_fans += counts[j++].second;
-    ++vertices;
-    if (open_fans > 1) return false;
-    i = j;
-  }
-  return has_boundary && vertices - distinct_edges + n == 1;
+  if (triangles.empty()) return false;
+  const TriangleTopology link = triangle_topology(triangles, scratch.topology);
+  return link.overloaded_edges == 0 && link.boundary_edges > 0 && link.components == 1 &&
+         link.pinched_vertices == 0 && link.euler() == 1;
 }
 
 // Flags, for each node in `nodes`, whether its link in the region is not a disk (in parallel).
@@ -395,28 +354,12 @@ BallCheck boundary_topology(const TetMesh& mesh, const TetRegion& region, std::v
         faces.push_back(mesh.outward_face(t, f));
         check.non_axis_faces += !face_is_axis_parallel(mesh, t, f);
       }
-  std::vector<std::pair<Edge, int>> edges;
   std::vector<VertexId> vertices;
-  for (int i = 0; i < static_cast<int>(faces.size()); ++i)
-    for (int k = 0; k < 3; ++k) {
-      edges.push_back({make_edge(faces[i][k], faces[i][(k + 1) % 3]), i});
-      vertices.push_back(faces[i][k]);
-    }
-  std::sort(edges.begin(), edges.end());
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-  UnionFind components(faces.size());
-  std::int64_t distinct_edges = 0;
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i + 1;
-    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
-    ++distinct_edges;
-    if (j - i != 2) ++check.non_manifold_edges;
-    for (std::size_t k = i + 1; k < j; ++k) components.join(edges[i].second, edges[k].second);
-    i = j;
-  }
-  check.boundary_components = components.components();
-  check.boundary_euler = static_cast<std::int64_t>(vertices.size()) - distinct_edges + static_cast<std::int64_t>(faces.size());
+  TopologyScratch scratch;
+  const TriangleTopology boundary = triangle_topology(faces, scratch, &vertices);
+  check.non_manifold_edges = boundary.boundary_edges + boundary.overloaded_edges;
+  check.boundary_components = boundary.components;
+  check.boundary_euler = boundary.euler();
   if (boundary_vertices) *boundary_vertices = std::move(vertices);
   return check;
 }

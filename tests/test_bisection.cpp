@@ -31,9 +31,18 @@ void expect_valid(const TetMesh& mesh) {
   ASSERT_TRUE(report.ok()) << report.summary();
 }
 
+// Computational points in cell units, where every cell holds the Kuhn shapes whatever the box's aspect.
+TetPoints cell_unit_points(const TetMesh& mesh, TetId t) {
+  const auto v = mesh.oriented_tet(t);
+  TetPoints p;
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 3; ++k) p[i][k] = static_cast<double>(mesh.grid[v[i]][k]) / static_cast<double>(grid_cell);
+  return p;
+}
+
 // Sorted edge lengths in computational space, scaled by the longest: equal for similar tets.
 std::array<double, 6> shape_signature(const TetMesh& mesh, TetId t) {
-  const auto p = oriented_computational_points(mesh, t);
+  const auto p = cell_unit_points(mesh, t);
   std::array<double, 6> lengths{};
   int e = 0;
   for (int i = 0; i < 4; ++i)
@@ -46,7 +55,7 @@ std::array<double, 6> shape_signature(const TetMesh& mesh, TetId t) {
 std::map<std::array<double, 6>, double> similarity_classes(const TetMesh& mesh) {
   std::map<std::array<double, 6>, double> classes;  // signature -> equilateral mean ratio
   for (TetId t = 0; t < mesh.num_tets(); ++t)
-    classes.emplace(shape_signature(mesh, t), mean_ratio_equilateral(oriented_computational_points(mesh, t)));
+    classes.emplace(shape_signature(mesh, t), mean_ratio_equilateral(cell_unit_points(mesh, t)));
   return classes;
 }
 
@@ -59,7 +68,7 @@ void expect_kuhn_classes(const std::map<std::array<double, 6>, double>& classes)
 
 void expect_dihedral_angles_within_kuhn_bounds(const TetMesh& mesh) {
   for (TetId t = 0; t < mesh.num_tets(); ++t)
-    for (double angle : dihedral_angles_deg(oriented_computational_points(mesh, t))) {
+    for (double angle : dihedral_angles_deg(cell_unit_points(mesh, t))) {
       ASSERT_GE(angle, 45.0 - 1e-9) << "tet " << t;
       ASSERT_LE(angle, 120.0 + 1e-9) << "tet " << t;
     }
@@ -115,7 +124,7 @@ TEST(CubeMeccano, UniformRefinementKeepsThreeSimilarityClassesAndKuhnAngles) {
       const auto& v = mesh.tets[t];
       Eigen::Vector3d d;
       for (int k = 0; k < 3; ++k) d[k] = static_cast<double>(mesh.grid[v[0]][k] - mesh.grid[v[1]][k]);
-      const auto p = oriented_computational_points(mesh, t);
+      const auto p = cell_unit_points(mesh, t);
       double longest = 0;
       for (int i = 0; i < 4; ++i)
         for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (p[i] - p[j]).norm());

@@ -1,0 +1,520 @@
+// reference-gmsh: the reference mesh that meccano-immerse is compared with. Gmsh (C++ API) re-meshes the
+// whole box with the surfaces embedded as constraints, keeping every input triangle as it is, and writes
+// the same physical groups as meccano-immerse, so that both outputs go through the same readers and the
+// same quality code (meccano/quality.hpp).
+//
+// Recipe ("keep", shared/notes/peers.md §2.2): each surface becomes a discrete Gmsh surface;
+// classifySurfaces creates its rim curve without reparametrizing it, so Gmsh never remeshes it; the box
+// is a built-in (geo) volume built *after* the classification, which clears built-in entities; the
+// surfaces are embedded in the volume.
+// Exit status: 0 success, 1 failure (bad input data, meshing failed, cannot write), 2 usage error.
+
+#include <meccano/atomic_file.hpp>
+#include <meccano/box.hpp>
+#include <meccano/error.hpp>
+#include <meccano/json_writer.hpp>
+#include <meccano/quality.hpp>
+#include <meccano/surface.hpp>
+#include <meccano/surface_validation.hpp>
+#include <meccano/tet_mesh.hpp>
+
+#include <gmsh.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace {
+
+constexpr const char* usage_text = R"(Usage: reference-gmsh --box XMIN YMIN ZMIN XMAX YMAX ZMAX --surface FILE[:NAME] [--surface ...]
+                      --size H --output FILE.msh [options]
+
+Builds the reference tetrahedral mesh that meccano-immerse is compared with: Gmsh 3D meshes the box
+with the surfaces embedded, keeping every surface triangle as it is, and writes the groups that
+meccano-immerse writes.
+
+Options:
+  --box XMIN YMIN ZMIN XMAX YMAX ZMAX  the box (required); the comma form of meccano-immerse,
+                           --box X0,Y0,Z0,X1,Y1,Z1, is accepted too
+  --surface FILE[:NAME]    an open triangulated surface strictly inside the box (.obj, .stl, .off,
+                           .msh); NAME defaults to its 1-based position (may repeat; at least one)
+  --size H                 mesh size on the box (required); near a surface the tets follow the size
+                           of its triangles, which Gmsh cannot split: below 0.7 x their mean edge
+                           length it leaves nearly flat tets against them (a warning says so)
+  --output FILE.msh        Gmsh MSH 4.1 ASCII with the 3D group `domain`, the 2D groups xmin, xmax,
+                           ymin, ymax, zmin, zmax and interface_NAME per surface (required)
+  --algorithm hxt|delaunay Gmsh's 3D algorithm: HXT (Mesh.Algorithm3D = 10, default) or Delaunay (1);
+                           both followed by Gmsh's default tet optimizer (Mesh.Optimize = 1)
+  --threads N              threads for Gmsh (General.NumThreads; default 1; HXT uses them)
+  --report FILE.json       counts, timings and quality: equilateral mean ratio min/mean/std and
+                           min/max dihedral angle, computed by meccano's own quality functions
+  --quiet                  no progress output and no Gmsh messages
+  --help                   this text
+
+Example:
+  reference-gmsh --box 0 0 0 1 1 1 --surface meshes/cube_example.obj:patch --size 0.05 \
+                 --output reference.msh --report reference.json
+)";
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+enum class Algorithm { hxt, delaunay };
+
+struct Options {
+  meccano::Box box;
+  bool box_given = false;
+  std::vector<std::pair<std::string, std::string>> surfaces;  // file, name
+  std::optional<double> size;
+  std::string output;
+  Algorithm algorithm = Algorithm::hxt;
+  int threads = 1;
+  std::optional<std::string> report;
+  bool quiet = false;
+};
+
+// FILE[:NAME] exactly as meccano-immerse reads it: a colon followed by a path separator belongs to the
+// file name.
+std::pair<std::string, std::string> parse_surface(const std::string& text, std::size_t position) {
+  const auto colon = text.rfind(':');
+  if (colon != std::string::npos && colon > 0 && text.find('/', colon) == std::string::npos) {
+    const std::string name = text.substr(colon + 1);
+    if (name.empty()) throw UsageError("--surface " + text + ": empty name after ':'");
+    for (char c : name)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-')
+        throw UsageError("--surface " + text + ": a name may hold letters, digits, '_' and '-' only");
+    return {text.substr(0, colon), name};
+  }
+  return {text, std::to_string(position)};
+}
+
+double parse_number(const std::string& option, const std::string& text) {
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value))
+    throw UsageError(option + ": '" + text + "' is not a finite number");
+  return value;
+}
+
+bool ends_with(const std::string& text, const std::string& suffix) {
+  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+Options parse_options(int argc, char** argv) {
+  Options options;
+  std::vector<std::string> args(argv + 1, argv + argc);
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw UsageError(arg + " needs a value");
+      return args[++i];
+    };
+    if (arg == "--help" || arg == "-h") {
+      std::cout << usage_text;
+      std::exit(0);
+    } else if (arg == "--box") {
+      // Six separate numbers, or one comma-separated list as meccano-immerse takes it.
+      std::vector<std::string> items;
+      if (const std::string& first = value(); first.find(',') != std::string::npos) {
+        std::stringstream stream(first);
+        for (std::string item; std::getline(stream, item, ',');) items.push_back(item);
+      } else {
+        items.push_back(first);
+        while (items.size() < 6 && i + 1 < args.size() && !args[i + 1].starts_with("--")) items.push_back(args[++i]);
+      }
+      if (items.size() != 6) throw UsageError("--box takes 6 numbers: XMIN YMIN ZMIN XMAX YMAX ZMAX");
+      std::array<double, 6> v{};
+      for (int k = 0; k < 6; ++k) v[k] = parse_number(arg, items[k]);
+      options.box = {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+      for (int k = 0; k < 3; ++k)
+        if (!(v[k] < v[k + 3])) throw UsageError("--box: every minimum must be below its maximum");
+      options.box_given = true;
+    } else if (arg == "--surface") {
+      options.surfaces.push_back(parse_surface(value(), options.surfaces.size() + 1));
+    } else if (arg == "--size") {
+      options.size = parse_number(arg, value());
+      if (!(*options.size > 0)) throw UsageError("--size must be positive");
+    } else if (arg == "--output" || arg == "-o") {
+      options.output = value();
+    } else if (arg == "--algorithm") {
+      const std::string& name = value();
+      if (name == "hxt") options.algorithm = Algorithm::hxt;
+      else if (name == "delaunay") options.algorithm = Algorithm::delaunay;
+      else throw UsageError("--algorithm " + name + ": the algorithms available are: hxt, delaunay");
+    } else if (arg == "--threads") {
+      const double threads = parse_number(arg, value());
+      if (threads != std::floor(threads) || threads < 1 || threads > 1024)
+        throw UsageError("--threads takes an integer between 1 and 1024");
+      options.threads = static_cast<int>(threads);
+    } else if (arg == "--report") {
+      options.report = value();
+    } else if (arg == "--quiet" || arg == "-q") {
+      options.quiet = true;
+    } else {
+      throw UsageError("unknown option '" + arg + "'");
+    }
+  }
+  if (!options.box_given) throw UsageError("--box is required");
+  if (options.surfaces.empty()) throw UsageError("--surface is required");
+  if (!options.size) throw UsageError("--size is required");
+  if (options.output.empty()) throw UsageError("--output is required");
+  if (!ends_with(options.output, ".msh")) throw UsageError("--output " + options.output + ": only .msh output is supported");
+  if (options.report && !ends_with(*options.report, ".json"))
+    throw UsageError("--report " + *options.report + ": the report is a .json file");
+  for (std::size_t i = 0; i < options.surfaces.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (options.surfaces[i].second == options.surfaces[j].second)
+        throw UsageError("two surfaces are named " + options.surfaces[i].second);
+  return options;
+}
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+class Progress {
+ public:
+  explicit Progress(bool quiet) : quiet_(quiet) {}
+  template <class... Parts>
+  void say(const Parts&... parts) const {
+    if (quiet_) return;
+    std::ostringstream line;
+    line << "[" << std::fixed << std::setprecision(3) << seconds_since(start_) << " s] " << std::defaultfloat;
+    (line << ... << parts);
+    std::cerr << line.str() << std::endl;
+  }
+
+ private:
+  bool quiet_;
+  Clock::time_point start_ = Clock::now();
+};
+
+// Gmsh keeps global state: one model per process, finalized on every way out.
+class GmshSession {
+ public:
+  GmshSession() { gmsh::initialize(0, nullptr, /*readConfigFiles=*/false); }
+  ~GmshSession() { gmsh::finalize(); }
+  GmshSession(const GmshSession&) = delete;
+  GmshSession& operator=(const GmshSession&) = delete;
+};
+
+// Adds every surface as a discrete surface and returns, per surface, the tag of the discrete surface
+// that holds its triangles after classifySurfaces (which renumbers the entities but keeps node tags).
+std::vector<int> add_surfaces(const std::vector<meccano::TriangleSurface>& surfaces) {
+  std::vector<std::size_t> first_node_tag;
+  std::size_t next_node_tag = 1;
+  for (const auto& surface : surfaces) {
+    const int entity = gmsh::model::addDiscreteEntity(2);
+    first_node_tag.push_back(next_node_tag);
+    std::vector<std::size_t> node_tags;
+    std::vector<double> coordinates;
+    for (const auto& p : surface.points) {
+      node_tags.push_back(next_node_tag++);
+      coordinates.insert(coordinates.end(), {p.x(), p.y(), p.z()});
+    }
+    std::vector<std::size_t> triangle_nodes;
+    for (const auto& triangle : surface.triangles)
+      for (int corner : triangle) triangle_nodes.push_back(first_node_tag.back() + static_cast<std::size_t>(corner));
+    gmsh::model::mesh::addNodes(2, entity, node_tags, coordinates);
+    gmsh::model::mesh::addElementsByType(entity, 2, {}, triangle_nodes);
+  }
+  // Angle pi: no surface is split at a crease; boundary curves for the rims; no reparametrization, so
+  // Gmsh keeps the triangles.
+  gmsh::model::mesh::classifySurfaces(std::numbers::pi, true, false, std::numbers::pi);
+
+  std::vector<int> entity_of_surface(surfaces.size(), -1);
+  gmsh::vectorpair entities;
+  gmsh::model::getEntities(entities, 2);
+  for (const auto& [dim, tag] : entities) {
+    std::vector<std::size_t> element_tags, node_tags;
+    gmsh::model::mesh::getElementsByType(2, element_tags, node_tags, tag);
+    if (node_tags.empty()) continue;
+    const auto s = static_cast<std::size_t>(
+        std::upper_bound(first_node_tag.begin(), first_node_tag.end(), node_tags.front()) - first_node_tag.begin() - 1);
+    if (entity_of_surface[s] != -1 || element_tags.size() != surfaces[s].triangles.size())
+      throw meccano::MeshingError("Gmsh split surface " + surfaces[s].name + " into several pieces");
+    entity_of_surface[s] = tag;
+  }
+  for (std::size_t s = 0; s < surfaces.size(); ++s)
+    if (entity_of_surface[s] == -1) throw meccano::MeshingError("Gmsh lost surface " + surfaces[s].name);
+  return entity_of_surface;
+}
+
+struct BoxEntities {
+  int volume = -1;
+  std::array<int, 6> sides{};  // in meccano::BoxSide order
+};
+
+// The box in Gmsh's built-in kernel, every point with mesh size h. Corner c has coordinate k at the
+// maximum when bit k of c is set; sides are numbered 2k + (0 at the minimum, 1 at the maximum), which is
+// meccano::BoxSide's order.
+BoxEntities add_box(const meccano::Box& box, double h) {
+  std::array<int, 8> corner_tags{};
+  for (int c = 0; c < 8; ++c) {
+    const auto coordinate = [&](int k) { return (c >> k & 1) ? box.max[k] : box.min[k]; };
+    corner_tags[c] = gmsh::model::geo::addPoint(coordinate(0), coordinate(1), coordinate(2), h);
+  }
+  std::map<std::pair<int, int>, int> line_of_edge;  // (from corner, to corner) with from < to
+  for (int c = 0; c < 8; ++c)
+    for (int k = 0; k < 3; ++k)
+      if (!(c >> k & 1)) line_of_edge[{c, c | 1 << k}] = gmsh::model::geo::addLine(corner_tags[c], corner_tags[c | 1 << k]);
+  const auto oriented_line = [&](int from, int to) {
+    return from < to ? line_of_edge.at({from, to}) : -line_of_edge.at({to, from});
+  };
+  BoxEntities entities;
+  for (int k = 0; k < 3; ++k)
+    for (int at_max = 0; at_max < 2; ++at_max) {
+      // Counter-clockwise around +k seen from outside at the maximum; reversed at the minimum, so that
+      // every side's normal points out of the box.
+      const int a = (k + 1) % 3, b = (k + 2) % 3, base = at_max << k;
+      std::array<int, 4> quad{base, base | 1 << a, base | 1 << a | 1 << b, base | 1 << b};
+      if (!at_max) std::reverse(quad.begin(), quad.end());
+      const int loop = gmsh::model::geo::addCurveLoop({oriented_line(quad[0], quad[1]), oriented_line(quad[1], quad[2]),
+                                                       oriented_line(quad[2], quad[3]), oriented_line(quad[3], quad[0])});
+      entities.sides[2 * k + at_max] = gmsh::model::geo::addPlaneSurface({loop});
+    }
+  const int shell = gmsh::model::geo::addSurfaceLoop({entities.sides.begin(), entities.sides.end()});
+  entities.volume = gmsh::model::geo::addVolume({shell});
+  return entities;
+}
+
+void add_named_group(int dim, const std::vector<int>& entities, const std::string& name) {
+  const int group = gmsh::model::addPhysicalGroup(dim, entities);
+  gmsh::model::setPhysicalName(dim, group, name);
+}
+
+struct MeshSummary {
+  std::size_t tets = 0;
+  std::size_t nodes = 0;
+  std::size_t inverted = 0;  // signed volume not positive (or not a number)
+  // Equilateral mean ratio over all tets, an inverted one counting as 0; std is the population's.
+  double min_mean_ratio = 0.0, mean_mean_ratio = 0.0, std_mean_ratio = 0.0;
+  double min_dihedral_deg = 180.0, max_dihedral_deg = 0.0;  // over the tets that are not inverted
+};
+
+// Counts and quality of the tets Gmsh made, by meccano's per-tet quality functions and with the rules
+// of meccano::summarize_quality (inverted tets count as quality 0, dihedral angles of valid tets only,
+// Welford's running mean and variance), so that both tools are measured alike. summarize_quality itself
+// takes a meccano TetMesh, which a Gmsh mesh is not.
+MeshSummary summarize_mesh() {
+  std::vector<std::size_t> node_tags;
+  std::vector<double> coordinates, parametric;
+  gmsh::model::mesh::getNodes(node_tags, coordinates, parametric);
+  const std::size_t max_tag = node_tags.empty() ? 0 : *std::max_element(node_tags.begin(), node_tags.end());
+  std::vector<Eigen::Vector3d> point_of_tag(max_tag + 1);
+  for (std::size_t i = 0; i < node_tags.size(); ++i)
+    point_of_tag[node_tags[i]] = {coordinates[3 * i], coordinates[3 * i + 1], coordinates[3 * i + 2]};
+
+  std::vector<std::size_t> tet_tags, tet_nodes;
+  gmsh::model::mesh::getElementsByType(4, tet_tags, tet_nodes);
+  if (tet_tags.empty()) throw meccano::MeshingError("Gmsh produced no tetrahedra");
+  MeshSummary summary{.tets = tet_tags.size(), .nodes = node_tags.size(), .min_mean_ratio = 1.0};
+  double squared_deviations = 0.0;
+  for (std::size_t t = 0; t < tet_tags.size(); ++t) {
+    meccano::TetPoints p;
+    for (int i = 0; i < 4; ++i) p[i] = point_of_tag[tet_nodes[4 * t + i]];
+    const double volume = meccano::signed_volume(p[0], p[1], p[2], p[3]);
+    const bool valid = volume > 0.0 && std::isfinite(volume);
+    // Clamped because rounding may flip the sign of a nearly flat tet's determinant.
+    const double eta = valid ? std::max(0.0, meccano::mean_ratio_equilateral(p)) : 0.0;
+    summary.inverted += valid ? 0 : 1;
+    summary.min_mean_ratio = std::min(summary.min_mean_ratio, eta);
+    const double delta = eta - summary.mean_mean_ratio;
+    summary.mean_mean_ratio += delta / static_cast<double>(t + 1);
+    squared_deviations += delta * (eta - summary.mean_mean_ratio);
+    if (!valid) continue;
+    for (double angle : meccano::dihedral_angles_deg(p)) {
+      summary.min_dihedral_deg = std::min(summary.min_dihedral_deg, angle);
+      summary.max_dihedral_deg = std::max(summary.max_dihedral_deg, angle);
+    }
+  }
+  summary.std_mean_ratio = std::sqrt(squared_deviations / static_cast<double>(tet_tags.size()));
+  return summary;
+}
+
+// gmsh::write picks the format from the extension, so the temporary name ends in .msh too; it lives in
+// the target's directory so that the rename is atomic.
+void write_msh_atomically(const std::string& path) {
+  namespace fs = std::filesystem;
+  const std::string temporary = path + ".tmp" + std::to_string(::getpid()) + ".msh";
+  try {
+    gmsh::write(temporary);
+  } catch (const std::string& gmsh_error) {
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+    throw meccano::InputError("cannot write " + path + ": " + gmsh_error);
+  }
+  std::error_code error;
+  fs::rename(temporary, path, error);
+  if (error) {
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+    throw meccano::InputError("cannot write " + path + ": " + error.message());
+  }
+}
+
+struct RunRecord {
+  const Options& options;
+  std::vector<std::pair<std::string, std::size_t>> interface_triangles;  // name, count
+  MeshSummary mesh;
+  double meshing_seconds = 0.0;
+};
+
+// Key names follow meccano::QualitySummary, so that the two tools' reports read alike.
+void write_report(const RunRecord& run, double total_seconds, const std::string& path) {
+  std::string version;
+  gmsh::option::getString("General.Version", version);
+  meccano::JsonWriter json;
+  json.begin_object()
+      .key("tool").value("reference-gmsh")
+      .key("gmsh_version").value(version)
+      .key("algorithm").value(run.options.algorithm == Algorithm::hxt ? "hxt" : "delaunay")
+      .key("threads").value(run.options.threads)
+      .key("size").value(*run.options.size)
+      .key("tets").value(run.mesh.tets)
+      .key("nodes").value(run.mesh.nodes)
+      .key("inverted").value(run.mesh.inverted)
+      .key("interface_triangles").begin_object();
+  for (const auto& [name, count] : run.interface_triangles) json.key(name).value(count);
+  json.end_object()
+      .key("seconds").begin_object()
+      .key("meshing").value(run.meshing_seconds)
+      .key("total").value(total_seconds)
+      .end_object()
+      .key("quality").begin_object()
+      .key("equilateral").begin_object()
+      .key("min").value(run.mesh.min_mean_ratio)
+      .key("mean").value(run.mesh.mean_mean_ratio)
+      .key("std").value(run.mesh.std_mean_ratio)
+      .end_object()
+      .key("min_dihedral_deg").value(run.mesh.min_dihedral_deg)
+      .key("max_dihedral_deg").value(run.mesh.max_dihedral_deg)
+      .end_object()
+      .end_object();
+  meccano::write_file_atomically(path, [&](std::ostream& out) { out << json.str(); });
+}
+
+// Gmsh cannot split the kept triangles, and when the tets around them must be much smaller HXT leaves
+// nearly flat tets against them (measured on the cube example's patch on a 24 x 24 grid: size / mean
+// edge 0.71 gives eta_min 0.42, 0.61 gives eta_min 0.003 and dihedral angles of 0.01 and 180 degrees;
+// the 48 x 48 grid of meshes/cube_example.obj at size / mean edge 0.42: eta_min 0.001).
+constexpr double finest_size_for_kept_triangles = 0.7;
+
+double mean_edge_length(const meccano::TriangleSurface& surface) {
+  double sum = 0.0;
+  for (const auto& t : surface.triangles)
+    for (int k = 0; k < 3; ++k) sum += (surface.points[t[(k + 1) % 3]] - surface.points[t[k]]).norm();
+  return sum / (3.0 * static_cast<double>(surface.triangles.size()));
+}
+
+int run(const Options& options) {
+  const auto start = Clock::now();
+  const Progress progress(options.quiet);
+  // Read and validate every surface before Gmsh starts: the same inputs as meccano-immerse, with the
+  // same messages.
+  std::vector<meccano::TriangleSurface> surfaces;
+  for (const auto& [file, name] : options.surfaces) {
+    surfaces.push_back(meccano::read_surface(file));
+    surfaces.back().name = name;
+    progress.say("surface ", name, ": ", file, ", ", surfaces.back().triangles.size(), " triangles, ",
+                 surfaces.back().points.size(), " points");
+  }
+  meccano::validate_surfaces(surfaces, options.box);
+  progress.say("surfaces valid: open disks, inside the box, disjoint");
+  for (const auto& surface : surfaces)
+    if (const double edge = mean_edge_length(surface); *options.size < finest_size_for_kept_triangles * edge)
+      progress.say("warning: --size ", *options.size, " is below ", finest_size_for_kept_triangles,
+                   " x the mean edge length ", edge, " of surface ", surface.name,
+                   ": next to its kept triangles Gmsh leaves nearly flat tets");
+
+  const GmshSession session;
+  gmsh::option::setNumber("General.Terminal", options.quiet ? 0 : 1);
+  gmsh::option::setNumber("General.Verbosity", 2);  // errors and warnings; progress is ours
+  gmsh::option::setNumber("General.NumThreads", options.threads);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", *options.size);
+  gmsh::option::setNumber("Mesh.Algorithm3D", options.algorithm == Algorithm::hxt ? 10 : 1);
+  gmsh::option::setNumber("Mesh.Optimize", 1);
+  gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
+  gmsh::option::setNumber("Mesh.Binary", 0);
+
+  gmsh::model::add("reference");
+  const std::vector<int> surface_entities = add_surfaces(surfaces);
+  const BoxEntities box = add_box(options.box, *options.size);
+  gmsh::model::geo::synchronize();
+  gmsh::model::mesh::embed(2, surface_entities, 3, box.volume);
+
+  add_named_group(3, {box.volume}, "domain");
+  for (int side = 0; side < 6; ++side)
+    add_named_group(2, {box.sides[side]}, meccano::box_side_name(static_cast<meccano::BoxSide>(side)));
+  for (std::size_t s = 0; s < surfaces.size(); ++s)
+    add_named_group(2, {surface_entities[s]}, "interface_" + surfaces[s].name);
+
+  progress.say("gmsh: meshing with ", options.algorithm == Algorithm::hxt ? "HXT" : "Delaunay", ", size ",
+               *options.size, ", ", options.threads, " thread(s)");
+  const auto meshing_start = Clock::now();
+  gmsh::model::mesh::generate(3);
+  const double meshing_seconds = seconds_since(meshing_start);
+
+  // The reference promises S as given: 3D boundary recovery must not have split any input triangle.
+  std::vector<std::pair<std::string, std::size_t>> interface_triangles;
+  for (std::size_t s = 0; s < surfaces.size(); ++s) {
+    std::vector<std::size_t> element_tags, node_tags;
+    gmsh::model::mesh::getElementsByType(2, element_tags, node_tags, surface_entities[s]);
+    if (element_tags.size() != surfaces[s].triangles.size())
+      throw meccano::MeshingError("Gmsh changed the triangles of surface " + surfaces[s].name + " (" +
+                                  std::to_string(surfaces[s].triangles.size()) + " given, " +
+                                  std::to_string(element_tags.size()) + " meshed)");
+    interface_triangles.emplace_back(surfaces[s].name, element_tags.size());
+  }
+  const RunRecord record{options, std::move(interface_triangles), summarize_mesh(), meshing_seconds};
+  progress.say("gmsh: ", record.mesh.tets, " tets, ", record.mesh.nodes, " nodes in ", record.meshing_seconds,
+               " s; mean ratio min ", record.mesh.min_mean_ratio, " mean ", record.mesh.mean_mean_ratio,
+               ", dihedral ", record.mesh.min_dihedral_deg, "..", record.mesh.max_dihedral_deg, " deg");
+
+  write_msh_atomically(options.output);
+  progress.say("wrote ", options.output);
+  if (options.report) {
+    write_report(record, seconds_since(start), *options.report);
+    progress.say("wrote ", *options.report);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(parse_options(argc, argv));
+  } catch (const UsageError& error) {
+    std::cerr << "reference-gmsh: " << error.what() << "\n(see reference-gmsh --help)\n";
+    return 2;
+  } catch (const std::exception& error) {
+    std::cerr << "reference-gmsh: error: " << error.what() << '\n';
+    return 1;
+  } catch (const std::string& gmsh_error) {  // the Gmsh 4.8 API throws its error messages as strings
+    std::cerr << "reference-gmsh: error: gmsh: " << gmsh_error << '\n';
+    return 1;
+  }
+}

@@ -40,6 +40,9 @@ struct NamedSurfaces {
 // patch (irregular triangles).
 std::vector<NamedSurfaces> named_test_surfaces(int n);
 
+// Distance from x to the rim polyline of a surface (its edges used by one triangle).
+double distance_to_rim(const TriangleSurface& surface, const Eigen::Vector3d& x);
+
 // A case of the stage tests: surfaces (inserted in order) in a box at a resolution.
 struct SurfaceCase {
   std::string name;  // a valid test name: letters, digits, '_'

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <sstream>
 
 namespace meccano {
@@ -321,16 +322,26 @@ std::vector<Edge> triangles_with_two_rim_edges(const TetMesh& mesh, const Interf
   return splits;
 }
 
-// Edges joining a node of S_M to a node of the box boundary or of another S_M, and dividing edges
-// (off the rim, between two rim nodes). Counted separately for the statistics.
+// Edges joining a node of S_M to a node of the box boundary or of another S_M; dividing edges (off the
+// rim, between two rim nodes); and, beyond the paper, chord edges: edges between two S_M nodes, not both
+// on the rim, that are not edges of S_M. Projection lays a chord on S, and the tets around an edge must
+// turn all the way round it, but those around a chord all lie on one side of S_M: some would be
+// inverted for good (a tet with four nodes on S_M, or two faces in it, has a chord). A chord's midpoint
+// is off S_M, since no face of S_M contains the chord. Counted separately for the statistics.
 struct EdgeDefects {
   std::vector<Edge> cross_surface;
   std::vector<Edge> dividing;
+  std::vector<Edge> chords;
   std::int64_t unfixable_nodes = 0;  // S_M nodes on the box or on another S_M themselves
 };
 
 EdgeDefects find_edge_defects(const TetMesh& mesh, const Interface& s, const VertexTets& incidence) {
   EdgeDefects d;
+  auto is_interface_edge = [&](VertexId a, VertexId b) {
+    bool found = false;
+    s.for_each_face_on_edge(make_edge(a, b), [&](int) { found = true; });
+    return found;
+  };
   for (VertexId a = 0; a < mesh.num_vertices(); ++a) {
     if (!s.on_interface[a]) continue;
     const bool a_elsewhere = on_box_boundary(mesh, a) || s.on_other_interface[a];
@@ -340,10 +351,15 @@ EdgeDefects find_edge_defects(const TetMesh& mesh, const Interface& s, const Ver
         if (b == a) continue;
         if (!a_elsewhere && (on_box_boundary(mesh, b) || s.on_other_interface[b]))
           d.cross_surface.push_back(make_edge(a, b));
-        if (a < b && s.on_rim[a] && s.on_rim[b] && !s.is_rim_edge(a, b)) d.dividing.push_back(make_edge(a, b));
+        if (a > b || !s.on_interface[b]) continue;
+        if (s.on_rim[a] && s.on_rim[b]) {
+          if (!s.is_rim_edge(a, b)) d.dividing.push_back(make_edge(a, b));
+        } else if (!is_interface_edge(a, b)) {
+          d.chords.push_back(make_edge(a, b));
+        }
       }
   }
-  for (auto* list : {&d.cross_surface, &d.dividing}) {
+  for (auto* list : {&d.cross_surface, &d.dividing, &d.chords}) {
     std::sort(list->begin(), list->end());
     list->erase(std::unique(list->begin(), list->end()), list->end());
   }
@@ -434,6 +450,7 @@ SurfaceApproximationCheck inspect(const TetMesh& mesh, const Interface& s) {
   const EdgeDefects defects = find_edge_defects(mesh, s, vertex_to_tets(mesh));
   c.cross_surface_edges = static_cast<std::int64_t>(defects.cross_surface.size());
   c.dividing_edges = static_cast<std::int64_t>(defects.dividing.size());
+  c.chord_edges = static_cast<std::int64_t>(defects.chords.size());
   c.nodes_on_box_or_other_surface = defects.unfixable_nodes;
   return c;
 }
@@ -618,7 +635,8 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
       return std::to_string(defects.unfixable_nodes) +
              " node(s) of S_M lie on the box boundary or on another surface's S_M (the surface is too close "
              "to them for this resolution)";
-    if (doubled.empty() && splits.empty() && defects.cross_surface.empty() && defects.dividing.empty()) {
+    if (doubled.empty() && splits.empty() && defects.cross_surface.empty() && defects.dividing.empty() &&
+        defects.chords.empty()) {
       SurfaceApproximationCheck check;
       check_disk(mesh, s, check);
       if (!check.is_disk()) return "S_M is not a disk: " + check.describe();
@@ -628,11 +646,13 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
       return {};
     }
     stats.tets_with_two_faces += static_cast<std::int64_t>(doubled.size());
+    stats.chord_edges += static_cast<std::int64_t>(defects.chords.size());
     stats.triangles_with_two_rim_edges += triangle_splits;
     stats.cross_surface_edges += static_cast<std::int64_t>(defects.cross_surface.size());
     stats.dividing_edges += static_cast<std::int64_t>(defects.dividing.size());
     splits.insert(splits.end(), defects.cross_surface.begin(), defects.cross_surface.end());
     splits.insert(splits.end(), defects.dividing.begin(), defects.dividing.end());
+    splits.insert(splits.end(), defects.chords.begin(), defects.chords.end());
     std::sort(splits.begin(), splits.end());
     splits.erase(std::unique(splits.begin(), splits.end()), splits.end());
     EdgeSplitter splitter(mesh, regions);
@@ -651,7 +671,8 @@ std::string SurfaceApproximationCheck::describe() const {
       << " non-manifold edge(s), " << oblique_rim_edges << " oblique rim edge(s), " << corbels << " corbel(s), "
       << reflex_rim_corners << " reflex rim corner(s) (allowed), " << tets_with_two_faces
       << " tet(s) with two faces, " << triangles_with_two_rim_edges << " triangle(s) with two rim edges, "
-      << cross_surface_edges << " cross-surface edge(s), " << dividing_edges << " dividing edge(s), "
+      << cross_surface_edges << " cross-surface edge(s), " << dividing_edges << " dividing edge(s), " << chord_edges
+      << " chord edge(s), "
       << nodes_on_box_or_other_surface << " node(s) on the box or another surface";
   return out.str();
 }

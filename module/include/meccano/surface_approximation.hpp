@@ -28,6 +28,9 @@
 //             refine triangles of M with more than one edge on the rim (split their longest edge);
 //             refine edges joining a node of S_M to a node of another S_M or of the box boundary;
 //             refine dividing edges (edges off the rim joining two rim nodes);
+//             beyond the paper, refine chord edges (edges off S_M joining two of its nodes, not both on
+//             the rim): projection lays a chord on S with all its tets on one side, so some would stay
+//             inverted whatever SUS does;
 //          each pass re-applying steps 2-3 (component and hole clean-up, axis-parallel rim).
 //          Refinement is Kossaczky bisection: the mesh stays conforming; V_M and the other surfaces'
 //          regions follow through the child callback; S_M follows as a face tag.
@@ -36,7 +39,7 @@
 // Output   S_M as the faces tagged interface_tag(k), and the statistics of every rule.
 // Invariants on return (check_surface_approximation): S_M is one connected manifold disk (Euler
 //          characteristic 1, one rim loop, no pinched node), every rim edge is axis-parallel, no corbel,
-//          tet with two faces in S_M, triangle with two rim edges, cross-surface or dividing edge
+//          tet with two faces in S_M, triangle with two rim edges, cross-surface, dividing or chord edge
 //          remains; no S_M node is on the box boundary or on another S_M. Reflex rim corners that
 //          could not be filled are counted, not forbidden.
 // Errors   MeshingError naming the rule that did not converge, or the defect that remains, if neither
@@ -75,6 +78,7 @@ struct HealingStats {
   std::int64_t triangles_with_two_rim_edges = 0;
   std::int64_t cross_surface_edges = 0;
   std::int64_t dividing_edges = 0;
+  std::int64_t chord_edges = 0;        // beyond the paper: off S_M, between two of its nodes
   std::int64_t faces = 0;              // S_M faces at the end
   std::int64_t rim_nodes = 0;
   std::string first_side_failure;      // why the first side was abandoned, if it was
@@ -108,13 +112,15 @@ struct SurfaceApproximationCheck {
   std::int64_t triangles_with_two_rim_edges = 0;
   std::int64_t cross_surface_edges = 0;
   std::int64_t dividing_edges = 0;
+  std::int64_t chord_edges = 0;
   std::int64_t nodes_on_box_or_other_surface = 0;
   bool is_disk() const {
     return faces > 0 && connected && non_manifold_edges == 0 && pinched_nodes == 0 && euler == 1 && rim_loops == 1;
   }
   bool healed() const {
-    return is_disk() && oblique_rim_edges == 0 && corbels == 0 && tets_with_two_faces == 0 && triangles_with_two_rim_edges == 0 && cross_surface_edges == 0 &&
-           dividing_edges == 0 && nodes_on_box_or_other_surface == 0;
+    return is_disk() && oblique_rim_edges == 0 && corbels == 0 && tets_with_two_faces == 0 &&
+           triangles_with_two_rim_edges == 0 && cross_surface_edges == 0 &&
+           dividing_edges == 0 && chord_edges == 0 && nodes_on_box_or_other_surface == 0;
   }
   std::string describe() const;
 };

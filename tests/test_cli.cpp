@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <string>
 
@@ -111,8 +112,18 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
       {"--box 0,0,0,1,1,1 --resolution 0.1 --output " + path("a.msh"), "need at least one --surface"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0 --stage volumetric --output " + path("a.msh"),
        "--resolution must be positive"},
-      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --stage smoothing --output " + path("a.msh"),
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --stage refinement --output " + path("a.msh"),
        "the stages available are"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --smoothing sideways --output " + path("a.msh"),
+       "the modes are whole and band"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --target cube --output " + path("a.msh"),
+       "the targets are meccano and equilateral"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --threads 0 --output " + path("a.msh"),
+       "--threads must be at least 1"},
+      {"--box 0,0,0,1,1,1 --histograms h.csv --output " + path("a.msh"), "need at least one --surface"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --stage projection --histograms h.csv --output " +
+           path("a.msh"),
+       "needs --stage smoothing"},
   };
   for (const auto& [arguments, message] : cases) {
     const CliRun run = run_cli(arguments);
@@ -199,6 +210,48 @@ TEST_F(CliTest, ProjectionStageWritesTheInterfaceOnTheSurface) {
   }
   gmsh::finalize();
   EXPECT_GT(checked, 0u) << "no interface_1 group";
+}
+
+// The whole method: an untangled mesh (every tet read back by Gmsh has positive volume), the report with
+// the keys scripts rely on, and the histograms.
+TEST_F(CliTest, FullPipelineWritesAnUntangledMeshAReportAndHistograms) {
+  const std::string file = write_obj("patch.obj", testing::paper_like_patch(12));
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + file + ":fault --resolution 0.07 --threads 2 --output " +
+                             path("mesh.msh") + " --report " + path("report.json") + " --histograms " + path("q.csv"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("smoothing:"), std::string::npos) << run.output;
+
+  gmsh::initialize();
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::open(path("mesh.msh"));
+  std::vector<std::size_t> node_tags;
+  std::vector<double> coords, parametric;
+  gmsh::model::mesh::getNodes(node_tags, coords, parametric);
+  std::map<std::size_t, Eigen::Vector3d> nodes;
+  for (std::size_t i = 0; i < node_tags.size(); ++i) nodes[node_tags[i]] = {coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]};
+  std::vector<std::size_t> element_tags, tets;
+  gmsh::model::mesh::getElementsByType(4, element_tags, tets);
+  gmsh::finalize();
+  ASSERT_FALSE(tets.empty());
+  for (std::size_t t = 0; t < tets.size(); t += 4) {
+    const Eigen::Vector3d& a = nodes.at(tets[t]);
+    ASSERT_GT((nodes.at(tets[t + 1]) - a).dot((nodes.at(tets[t + 2]) - a).cross(nodes.at(tets[t + 3]) - a)), 0.0)
+        << "tet " << t / 4 << " is inverted";
+  }
+  const auto sizes = group_sizes(path("mesh.msh"));
+  EXPECT_GT(sizes.count("interface_fault") ? sizes.at("interface_fault") : 0u, 0u);
+
+  std::ifstream report_file(path("report.json"));
+  const std::string report((std::istreambuf_iterator<char>(report_file)), std::istreambuf_iterator<char>());
+  for (const char* key : {"\"tets\"", "\"nodes\"", "\"inverted\": 0", "\"before_smoothing\"", "\"after_smoothing\"",
+                          "\"meccano\"", "\"equilateral\"", "\"min\"", "\"mean\"", "\"std\"", "\"min_dihedral_deg\"",
+                          "\"seconds\"", "\"smoothing\"", "\"total\""})
+    EXPECT_NE(report.find(key), std::string::npos) << key << " missing from\n" << report;
+  std::ifstream histogram_file(path("q.csv"));
+  std::string header;
+  std::getline(histogram_file, header);
+  EXPECT_EQ(header, "bin_low,bin_high,before_smoothing_meccano,before_smoothing_equilateral,after_smoothing_meccano,"
+                    "after_smoothing_equilateral");
 }
 
 TEST_F(CliTest, BadSurfacesFailWithTheirOwnMessageAndWriteNothing) {

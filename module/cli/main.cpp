@@ -1,6 +1,7 @@
 // meccano-immerse: the command-line front end of the module.
 // Exit status: 0 success, 1 failure (bad input data, meshing failed, cannot write), 2 usage error.
 
+#include <meccano/atomic_file.hpp>
 #include <meccano/cube_meccano.hpp>
 #include <meccano/error.hpp>
 #include <meccano/mesh_check.hpp>
@@ -9,6 +10,7 @@
 #include <meccano/surface.hpp>
 #include <meccano/surface_validation.hpp>
 
+#include <array>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -20,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include <omp.h>
 #include <unistd.h>
 
 namespace {
@@ -37,13 +40,28 @@ Options:
                            .msh); NAME defaults to its 1-based position (may repeat)
   --resolution L           l_r: tets meeting a surface are refined until their longest edge is below L
                            (required with --surface)
-  --stage STAGE            stop after this stage and write its result, for inspection:
+  --stage STAGE            stop after this stage and write its result (default: smoothing, the whole
+                           method); the earlier stages are for inspection:
                            volumetric     the refined mesh with the 3D group volumetric_NAME holding
                                           each surface's volumetric approximation V_M
                            approximation  also the 2D group interface_NAME: the healed surface
                                           approximation S_M (nodes not moved yet)
                            projection     S_M's nodes moved onto the surfaces; tets may be inverted
-                                          (this output only: smoothing is not implemented yet)
+                                          (this output only)
+                           smoothing      untangled and smoothed: the result
+  --smoothing MODE         whole (default: every node may move, as in the paper) or band (only nodes
+                           within --band-rings edge rings of the surfaces)
+  --band-rings N           rings of the band (default 3)
+  --target TARGET          the shape SUS aims for: meccano (default: each tet's computational
+                           counterpart, the paper's choice) or equilateral
+  --max-sweeps N           at most N smoothing sweeps (default 100); the run fails if tets are still
+                           inverted then
+  --threads N              OpenMP threads (default: all cores); the result does not depend on it
+  --report FILE.json       timings, counts and quality before and after smoothing (keys: tets, nodes,
+                           inverted, quality.before_smoothing / after_smoothing with meccano and
+                           equilateral min, mean, std; min_dihedral_deg; seconds per stage and total)
+  --histograms FILE.csv    quality histograms before and after smoothing, both measures (plot them
+                           with scripts/plot_quality.py)
   --output FILE.msh        Gmsh MSH 4.1 ASCII with the 3D group `domain`, the 2D groups xmin, xmax,
                            ymin, ymax, zmin, zmax, and the groups of the stage (may repeat)
   --quiet                  no progress output
@@ -52,6 +70,7 @@ Options:
 Examples:
   meccano-immerse --box 0,0,0,1,1,1 --level 9 --output cube.msh
   meccano-immerse --box 0,0,0,2,1,1 --level 6 --output bar.msh      (two unit cells)
+  meccano-immerse --box 0,0,0,1,1,1 --surface patch.obj:fault --resolution 0.03 --output fault.msh
   meccano-immerse --box 0,0,0,1,1,1 --surface patch.obj:fault --resolution 0.03 \
                   --stage volumetric --output fault_vm.msh
 )";
@@ -59,6 +78,18 @@ Examples:
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+constexpr std::array<std::pair<const char*, meccano::Stage>, 4> stage_names{{
+    {"volumetric", meccano::Stage::volumetric},
+    {"approximation", meccano::Stage::approximation},
+    {"projection", meccano::Stage::projection},
+    {"smoothing", meccano::Stage::smoothing}}};
+
+std::optional<meccano::Stage> stage_named(const std::string& name) {
+  for (const auto& [text, stage] : stage_names)
+    if (name == text) return stage;
+  return std::nullopt;
+}
 
 struct Options {
   meccano::Box box;
@@ -69,6 +100,10 @@ struct Options {
   std::vector<std::pair<std::string, std::string>> surfaces;  // file, name
   std::optional<double> resolution;
   std::optional<std::string> stage;
+  meccano::SmoothingOptions smoothing;
+  std::optional<int> threads;
+  std::optional<std::string> report;
+  std::optional<std::string> histograms;
   bool quiet = false;
 };
 
@@ -154,9 +189,32 @@ Options parse_options(int argc, char** argv) {
       options.resolution = l;
     } else if (arg == "--stage") {
       options.stage = value();
-      if (*options.stage != "volumetric" && *options.stage != "approximation" && *options.stage != "projection")
+      if (!stage_named(*options.stage))
         throw UsageError("--stage " + *options.stage +
-                         ": the stages available are: volumetric, approximation, projection");
+                         ": the stages available are: volumetric, approximation, projection, smoothing");
+    } else if (arg == "--smoothing") {
+      const std::string& mode = value();
+      if (mode != "whole" && mode != "band") throw UsageError("--smoothing " + mode + ": the modes are whole and band");
+      options.smoothing.mode = mode == "band" ? meccano::SmoothingMode::band : meccano::SmoothingMode::whole_mesh;
+    } else if (arg == "--band-rings") {
+      options.smoothing.band_rings = parse_int(arg, value());
+      if (options.smoothing.band_rings < 1) throw UsageError("--band-rings must be at least 1");
+    } else if (arg == "--target") {
+      const std::string& target = value();
+      if (target != "meccano" && target != "equilateral")
+        throw UsageError("--target " + target + ": the targets are meccano and equilateral");
+      options.smoothing.target =
+          target == "meccano" ? meccano::SmoothingTarget::meccano : meccano::SmoothingTarget::equilateral;
+    } else if (arg == "--max-sweeps") {
+      options.smoothing.max_sweeps = parse_int(arg, value());
+      if (options.smoothing.max_sweeps < 1) throw UsageError("--max-sweeps must be at least 1");
+    } else if (arg == "--threads") {
+      options.threads = parse_int(arg, value());
+      if (*options.threads < 1) throw UsageError("--threads must be at least 1");
+    } else if (arg == "--report") {
+      options.report = value();
+    } else if (arg == "--histograms") {
+      options.histograms = value();
     } else if (arg == "--output" || arg == "-o") {
       options.outputs.push_back(value());
     } else if (arg == "--quiet" || arg == "-q") {
@@ -168,10 +226,10 @@ Options parse_options(int argc, char** argv) {
   if (!options.box_given) throw UsageError("--box is required");
   if (options.outputs.empty()) throw UsageError("--output is required");
   if (!options.surfaces.empty() && !options.resolution) throw UsageError("--surface needs --resolution");
-  if (options.surfaces.empty() && (options.resolution || options.stage))
-    throw UsageError("--resolution and --stage need at least one --surface");
-  if (!options.surfaces.empty() && !options.stage)
-    throw UsageError("the pipeline stops at --stage projection so far: give --stage explicitly");
+  if (options.surfaces.empty() && (options.resolution || options.stage || options.histograms))
+    throw UsageError("--resolution, --stage and --histograms need at least one --surface");
+  if (options.histograms && options.stage && *options.stage != "smoothing")
+    throw UsageError("--histograms compares the mesh before and after smoothing: it needs --stage smoothing");
   for (std::size_t i = 0; i < options.surfaces.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (options.surfaces[i].second == options.surfaces[j].second)
@@ -203,6 +261,7 @@ class Progress {
 
 int run(const Options& options) {
   const Progress progress(options.quiet);
+  if (options.threads) omp_set_num_threads(*options.threads);
   const auto cells = options.cells ? *options.cells : meccano::cells_for_box(options.box);
   const std::int64_t expected_tets = (std::int64_t{6} * cells[0] * cells[1] * cells[2]) << options.level;
   progress.say("meccano: ", cells[0], "x", cells[1], "x", cells[2], " cells, level ", options.level, ", ",
@@ -223,9 +282,8 @@ int run(const Options& options) {
 
   meccano::InsertionOptions insertion;
   insertion.resolution = options.resolution.value_or(0.0);
-  insertion.last_stage = options.stage == "projection"      ? meccano::Stage::projection
-                         : options.stage == "approximation" ? meccano::Stage::approximation
-                                                            : meccano::Stage::volumetric;
+  insertion.last_stage = options.stage ? *stage_named(*options.stage) : meccano::Stage::smoothing;
+  insertion.smoothing = options.smoothing;
   insertion.progress = [&progress](const std::string& line) { progress.say(line); };
   const meccano::InsertionResult result = meccano::insert_surfaces(std::move(mesh), surfaces, insertion);
 
@@ -237,6 +295,17 @@ int run(const Options& options) {
   for (const auto& output : options.outputs) {
     meccano::write_msh41(result.mesh, groups, output);
     progress.say("wrote ", output, ": ", result.mesh.num_tets(), " tets, ", result.mesh.num_vertices(), " nodes");
+  }
+  if (options.histograms) {
+    const std::pair<std::string, const meccano::QualitySummary*> labelled[] = {
+        {"before_smoothing", &result.quality_before_smoothing}, {"after_smoothing", &result.quality_after_smoothing}};
+    meccano::write_quality_histograms_csv(*options.histograms, labelled);
+    progress.say("wrote ", *options.histograms);
+  }
+  if (options.report) {
+    const std::string report = meccano::insertion_report_json(result, insertion.last_stage);
+    meccano::write_file_atomically(*options.report, [&report](std::ostream& out) { out << report; });
+    progress.say("wrote ", *options.report);
   }
   return 0;
 }

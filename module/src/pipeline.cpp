@@ -27,9 +27,7 @@ void check_stage(const TetMesh& mesh, const char* stage) {
   if (!check.ok()) throw MeshingError(std::string("mesh invalid after the ") + stage + " stage: " + check.summary());
 }
 
-}  // namespace
-
-InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
+InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
   InsertionResult result;
   result.mesh = std::move(mesh);
   if (static_cast<int>(surfaces.size()) > max_interfaces)
@@ -53,7 +51,7 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
            " axis tets); mesh ", result.mesh.num_tets(), " tets");
   }
   check_stage(result.mesh, "volumetric");
-  if (options.last_stage == Stage::volumetric) return result;
+  if (options.last_stage == Stage::volumetric || surfaces.empty()) return result;
 
   // Step 2: the surface approximation of each surface, healed. Healing a later surface refines the
   // mesh near it, which can disturb an earlier S_M close by, so all are checked again and re-healed.
@@ -81,7 +79,7 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
              ", corbels ", h.corbels, ", reflex corners filled ", h.reflex_corners_filled, " left ", h.reflex_corners_left,
              ", tets with two faces ",
              h.tets_with_two_faces, ", triangles with two rim edges ", h.triangles_with_two_rim_edges,
-             ", cross-surface edges ", h.cross_surface_edges, ", dividing edges ", h.dividing_edges, "; mesh ",
+             ", cross-surface edges ", h.cross_surface_edges, ", dividing edges ", h.dividing_edges, ", chord edges ", h.chord_edges, "; mesh ",
              result.mesh.num_tets(), " tets");
     }
     if (!healed_any) break;
@@ -109,6 +107,37 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
   }
   const auto check = verify_mesh(result.mesh, {.physical = false});
   if (!check.ok()) throw MeshingError("mesh invalid after the projection stage: " + check.summary());
+  result.quality_before_smoothing = summarize_quality(result.mesh);
+  if (options.last_stage == Stage::projection) return result;
+
+  // Step 4: untangling and smoothing, every surface's nodes moving within it.
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<SurfaceProjection*> projections;
+  for (SurfaceInsertion& inserted : result.surfaces) projections.push_back(&inserted.projection);
+  result.smoothing = smooth_mesh(result.mesh, projections, options.smoothing);
+  result.smoothing_seconds = seconds_since(start);
+  const SmoothingStats& smoothing = result.smoothing;
+  const SweepRecord last = smoothing.sweeps.empty() ? SweepRecord{} : smoothing.sweeps.back();
+  report(options, "smoothing: ", smoothing.inner_nodes + smoothing.box_nodes + smoothing.surface_nodes + smoothing.rim_nodes,
+         " free nodes (", smoothing.surface_nodes, " on surfaces, ", smoothing.rim_nodes, " on rims), ", smoothing.colours,
+         " colours; ", smoothing.inverted_before, " inverted tets before, ", smoothing.inverted_after, " after ",
+         smoothing.sweeps.size(), " sweeps (untangled after ", smoothing.untangling_sweeps, "); quality min ",
+         last.min_quality, " mean ", last.mean_quality);
+  if (!smoothing.untangled())
+    throw MeshingError("smoothing could not untangle the mesh: " + std::to_string(smoothing.inverted_after) +
+                       " tets are still inverted after " + std::to_string(smoothing.sweeps.size()) +
+                       " sweeps; try a smaller resolution or the whole-mesh mode");
+  check_stage(result.mesh, "smoothing");
+  result.quality_after_smoothing = summarize_quality(result.mesh);
+  return result;
+}
+
+}  // namespace
+
+InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
+  const auto pipeline_start = std::chrono::steady_clock::now();
+  InsertionResult result = run_stages(std::move(mesh), surfaces, options);
+  result.seconds = seconds_since(pipeline_start);
   return result;
 }
 

@@ -60,6 +60,12 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
     result.on_rim[i] = rim[v];
     moved[i] = result.surface->evaluate(result.surface->locate(own.uv[v]));
   }
+  result.orientation = own.orientation;
+  for (const auto& t : triangles) {
+    std::array<int, 3>& local = result.triangles.emplace_back();
+    for (int k = 0; k < 3; ++k)
+      local[k] = static_cast<int>(std::lower_bound(result.nodes.begin(), result.nodes.end(), t[k]) - result.nodes.begin());
+  }
   for (std::int64_t i = 0; i < count; ++i) {
     const VertexId v = result.nodes[i];
     stats.largest_move = std::max(stats.largest_move, (moved[i] - mesh.points[v]).norm());

@@ -5,7 +5,8 @@
 //          2. surface approximation S_M of each surface, healed (surface_approximation.hpp); once all
 //             are built, any S_M that a later surface's refinement disturbed is healed again;
 //          3. projection of each S_M onto its surface (projection.hpp);
-//          4. smoothing: not implemented yet (the projected mesh is usually tangled).
+//          4. simultaneous untangling and smoothing of the whole mesh or of a band around the surfaces
+//             (smoothing.hpp); a mesh that stays tangled is an error, never a result.
 //          The surfaces are taken one after the other; a later surface's refinement keeps the earlier
 //          surfaces' regions in step (bisection does not change a region's point set).
 // Output   the refined mesh, each surface's V_M, per-stage statistics and timings.
@@ -14,6 +15,8 @@
 
 #include <meccano/mesh_io.hpp>
 #include <meccano/projection.hpp>
+#include <meccano/quality.hpp>
+#include <meccano/smoothing.hpp>
 #include <meccano/surface.hpp>
 #include <meccano/surface_approximation.hpp>
 #include <meccano/tet_mesh.hpp>
@@ -26,11 +29,12 @@
 
 namespace meccano {
 
-enum class Stage { volumetric, approximation, projection };
+enum class Stage { volumetric, approximation, projection, smoothing };
 
 struct InsertionOptions {
   double resolution = 0.0;  // l_r, a length in physical units
-  Stage last_stage = Stage::volumetric;
+  Stage last_stage = Stage::smoothing;
+  SmoothingOptions smoothing;
   std::function<void(const std::string&)> progress;
 };
 
@@ -48,7 +52,18 @@ struct SurfaceInsertion {
 struct InsertionResult {
   TetMesh mesh;
   std::vector<SurfaceInsertion> surfaces;
+  SmoothingStats smoothing;
+  double smoothing_seconds = 0.0;
+  QualitySummary quality_before_smoothing;  // right after projection (tets may be inverted)
+  QualitySummary quality_after_smoothing;
+  double seconds = 0.0;                     // the whole insertion
 };
+
+// The report of an insertion as a JSON document: tets, nodes, inverted (after smoothing), quality
+// before and after smoothing (meccano and equilateral min/mean/std, inverted, dihedral range),
+// min_dihedral_deg and max_dihedral_deg of the result, seconds per stage and in total, and per surface
+// the statistics of every stage. Keys of stages not run are left out.
+std::string insertion_report_json(const InsertionResult& result, Stage last_stage);
 
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options);
 

@@ -38,6 +38,8 @@ struct SurfaceProjection {
   std::vector<VertexId> nodes;                 // the S_M nodes
   std::vector<Eigen::Vector2d> uv;             // their parameters (same order)
   std::vector<std::uint8_t> on_rim;            // same order
+  std::vector<std::array<int, 3>> triangles;   // S_M's triangles as indices into `nodes`, oriented like S
+  int orientation = 1;                         // the sign of their areas in P (uv), which step 4 keeps
   ProjectionStats stats;
 };
 

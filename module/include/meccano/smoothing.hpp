@@ -1,0 +1,98 @@
+// Step 4 of the method (paper §4.4): simultaneous untangling and smoothing (SUS).
+//
+// Input    the mesh right after projection (tets may be inverted), and each surface's projection: its
+//          φ and each S_M node's parameters (projection.hpp).
+// Method   Every free node in turn minimises the sum, over the tets around it, of the regularised
+//          distortion η* = ||S||_F^2 / (3 h(σ)^(2/3)), S = A W^-1, σ = det S, h(σ) = (σ + √(σ² + 4δ²)) / 2
+//          (eqs. 5-7): A is the tet's physical edge matrix and W the target's, by default the tet's own
+//          computational (meccano) counterpart, so an untouched tet is already optimal. h keeps η* finite
+//          and smooth through σ = 0, so inverted tets are pushed out of inversion by the same descent that
+//          improves valid ones. δ = max(√(ε(ε − σ_min)), 1e-4 · mean|σ|) over the node's star (Escobar et
+//          al.'s rule with the authors' floor), ε = 1e-3 · mean|σ| (see smoothing.cpp for why not theirs).
+//          While tets are inverted the objective is the paper's sum; once a sweep ends with none, it
+//          becomes Σ η*^p with p = `power` (the p-norm of Escobar et al. 2003, of which the paper's sum is
+//          p = 1), which weighs the worst tets more: on the cube example p = 4 raises the minimum quality
+//          from 0.29 to 0.40 and lowers the mean by 0.01 (doc/results.md).
+//          Each node takes a few Newton steps with the analytic gradient and Hessian (its eigenvalues made
+//          positive where it is not convex), steps of at most half the star's edge length, and a
+//          backtracking (Armijo) line search.
+// Freedom  inner nodes move in R³; nodes on a box side move in its plane, on a box edge along it, box
+//          corners are fixed. S_M nodes move in P = [0,1]² and sit at φ(u): the gradient and Hessian reach
+//          u by the chain rule through dφ/du, and every trial point is located again in φ's parametric
+//          triangulation (a short walk from the last triangle); a step that would fold one of S_M's
+//          triangles in P is refused, so S_M stays embedded in S. Rim nodes of S move along their side of
+//          P, that is along the rim of S, and the four corners of P stay fixed: a fixed rim would keep the
+//          chord-length spacing of the projection, which ignores the volume mesh behind it.
+// Sweeps   non-linear Gauss-Seidel. Nodes are coloured so that no two nodes of one colour share a tet;
+//          the nodes of a colour are optimised in parallel, so the result does not depend on the thread
+//          count. A node is skipped when neither it nor any node of its star moved since it was last
+//          optimised. The sweeps stop after `smoothing_sweeps` sweeps that end with no inverted tet (the
+//          authors' rule), or earlier once such a sweep lowers the objective by less than `tolerance`
+//          (relative), or after `max_sweeps` sweeps.
+// Modes    whole mesh (the paper), or a band: only nodes within `band_rings` edge rings of an S_M node.
+// Output   the moved mesh and the surfaces' updated parameters; statistics per sweep. `untangled` is false
+//          if inverted tets remain: the caller must not present that mesh as a result.
+#pragma once
+
+#include <meccano/projection.hpp>
+#include <meccano/quality.hpp>
+#include <meccano/tet_mesh.hpp>
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace meccano {
+
+enum class SmoothingTarget { meccano, equilateral };
+enum class SmoothingMode { whole_mesh, band };
+
+struct SmoothingOptions {
+  SmoothingTarget target = SmoothingTarget::meccano;
+  SmoothingMode mode = SmoothingMode::whole_mesh;
+  int band_rings = 3;
+  int max_sweeps = 100;
+  int smoothing_sweeps = 20;
+  double tolerance = 1e-4;
+  double power = 4.0;    // p of Σ η*^p once untangled; 1 is the paper's objective
+  int newton_steps = 4;  // per node and sweep
+};
+
+struct SweepRecord {
+  std::int64_t inverted = 0;        // tets with σ <= 0 after the sweep
+  std::int64_t nodes_optimised = 0;
+  double min_quality = 0.0;         // 1/η against the target, over the tets of free nodes
+  double mean_quality = 0.0;
+  double power = 1.0;               // the exponent p the sweep minimised Σ η*^p with
+  double objective = 0.0;           // Σ η^p over those tets after the sweep
+  double seconds = 0.0;
+};
+
+struct SmoothingStats {
+  std::int64_t inner_nodes = 0;     // free nodes by freedom
+  std::int64_t box_nodes = 0;       // on a box side or edge
+  std::int64_t surface_nodes = 0;   // S_M nodes inside the rim
+  std::int64_t rim_nodes = 0;       // S_M rim nodes, corners of P excluded
+  std::int64_t active_tets = 0;     // tets with a free node
+  int colours = 0;
+  std::int64_t inverted_before = 0;
+  std::int64_t inverted_after = 0;
+  int untangling_sweeps = 0;        // sweeps until no tet was inverted (0 if none was)
+  std::vector<SweepRecord> sweeps;
+  bool untangled() const { return inverted_after == 0; }
+};
+
+// η* of one tet, S = A W^-1 with A the edge matrix of `physical` (oriented order) and W^-1 given, and its
+// gradient and Hessian with respect to the position of local vertex `vertex` (0..3). Infinite (and no
+// derivatives) when h(σ) underflows to 0, which needs δ = 0 and σ < 0.
+struct Distortion {
+  double value = 0.0;
+  Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();
+};
+Distortion regularised_distortion(const TetPoints& physical, const Eigen::Matrix3d& target_inverse, int vertex,
+                                  double delta);
+
+SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, const SmoothingOptions& options = {});
+
+}  // namespace meccano

@@ -1,0 +1,112 @@
+// The JSON report of an insertion (pipeline.hpp). Key names are an interface: scripts read them.
+
+#include <meccano/json_writer.hpp>
+#include <meccano/pipeline.hpp>
+
+namespace meccano {
+namespace {
+
+void write_statistics(JsonWriter& json, const char* name, const QualityStatistics& statistics) {
+  json.key(name).begin_object();
+  json.key("min").value(statistics.min).key("mean").value(statistics.mean).key("std").value(statistics.std);
+  json.end_object();
+}
+
+void write_quality(JsonWriter& json, const char* name, const QualitySummary& quality) {
+  json.key(name).begin_object();
+  write_statistics(json, "meccano", quality.meccano);
+  write_statistics(json, "equilateral", quality.equilateral);
+  json.key("inverted").value(quality.inverted);
+  json.key("min_dihedral_deg").value(quality.min_dihedral_deg).key("max_dihedral_deg").value(quality.max_dihedral_deg);
+  json.end_object();
+}
+
+void write_surface(JsonWriter& json, const SurfaceInsertion& inserted, Stage last_stage) {
+  json.begin_object().key("name").value(inserted.name);
+  const VolumetricStats& v = inserted.volumetric_stats;
+  json.key("volumetric").begin_object();
+  json.key("tets").value(v.tets).key("tets_meeting_surface").value(v.tets_intersecting);
+  json.key("refinement_passes").value(v.refinement_passes).key("bisections").value(v.bisections);
+  json.key("seconds").value(inserted.volumetric_seconds).end_object();
+  if (last_stage >= Stage::approximation) {
+    const HealingStats& h = inserted.healing_stats;
+    json.key("approximation").begin_object();
+    json.key("side").value(h.side).key("healing_passes").value(h.passes).key("faces").value(h.faces);
+    json.key("rim_nodes").value(h.rim_nodes).key("corbels").value(h.corbels);
+    json.key("reflex_corners_filled").value(h.reflex_corners_filled).key("reflex_corners_left").value(h.reflex_corners_left);
+    json.key("tets_with_two_faces").value(h.tets_with_two_faces);
+    json.key("triangles_with_two_rim_edges").value(h.triangles_with_two_rim_edges);
+    json.key("cross_surface_edges").value(h.cross_surface_edges).key("dividing_edges").value(h.dividing_edges);
+    json.key("chord_edges").value(h.chord_edges);
+    json.key("seconds").value(inserted.approximation_seconds).end_object();
+  }
+  if (last_stage >= Stage::projection) {
+    const ProjectionStats& p = inserted.projection.stats;
+    json.key("projection").begin_object();
+    json.key("nodes").value(p.nodes).key("rim_nodes").value(p.rim_nodes);
+    json.key("largest_move").value(p.largest_move).key("largest_distance_after").value(p.largest_distance_after);
+    json.key("inverted_tets").value(p.inverted_tets);
+    json.key("seconds").value(inserted.projection_seconds).end_object();
+  }
+  json.end_object();
+}
+
+void write_smoothing(JsonWriter& json, const SmoothingStats& s, double seconds) {
+  json.key("smoothing").begin_object();
+  json.key("inner_nodes").value(s.inner_nodes).key("box_nodes").value(s.box_nodes);
+  json.key("surface_nodes").value(s.surface_nodes).key("rim_nodes").value(s.rim_nodes);
+  json.key("active_tets").value(s.active_tets).key("colours").value(s.colours);
+  json.key("inverted_before").value(s.inverted_before).key("inverted_after").value(s.inverted_after);
+  json.key("untangling_sweeps").value(s.untangling_sweeps);
+  json.key("sweeps").begin_array();
+  for (const SweepRecord& sweep : s.sweeps) {
+    json.begin_object();
+    json.key("inverted").value(sweep.inverted).key("nodes_optimised").value(sweep.nodes_optimised);
+    json.key("min_quality").value(sweep.min_quality).key("mean_quality").value(sweep.mean_quality);
+    json.key("power").value(sweep.power).key("objective").value(sweep.objective);
+    json.key("seconds").value(sweep.seconds).end_object();
+  }
+  json.end_array();
+  json.key("seconds").value(seconds).end_object();
+}
+
+}  // namespace
+
+std::string insertion_report_json(const InsertionResult& result, Stage last_stage) {
+  const bool smoothed = last_stage == Stage::smoothing && !result.surfaces.empty();
+  const bool projected = last_stage >= Stage::projection && !result.surfaces.empty();
+  JsonWriter json;
+  json.begin_object();
+  json.key("tets").value(result.mesh.num_tets()).key("nodes").value(result.mesh.num_vertices());
+  const QualitySummary& final_quality = smoothed ? result.quality_after_smoothing : result.quality_before_smoothing;
+  if (projected) {
+    json.key("inverted").value(final_quality.inverted);
+    json.key("quality").begin_object();
+    write_quality(json, "before_smoothing", result.quality_before_smoothing);
+    if (smoothed) write_quality(json, "after_smoothing", result.quality_after_smoothing);
+    json.end_object();
+    json.key("min_dihedral_deg").value(final_quality.min_dihedral_deg);
+    json.key("max_dihedral_deg").value(final_quality.max_dihedral_deg);
+  }
+
+  double stage_seconds[4] = {0, 0, 0, result.smoothing_seconds};
+  for (const SurfaceInsertion& inserted : result.surfaces) {
+    stage_seconds[0] += inserted.volumetric_seconds;
+    stage_seconds[1] += inserted.approximation_seconds;
+    stage_seconds[2] += inserted.projection_seconds;
+  }
+  static constexpr const char* stage_keys[4] = {"volumetric", "approximation", "projection", "smoothing"};
+  json.key("seconds").begin_object();
+  for (int stage = 0; stage <= static_cast<int>(last_stage) && !result.surfaces.empty(); ++stage)
+    json.key(stage_keys[stage]).value(stage_seconds[stage]);
+  json.key("total").value(result.seconds).end_object();
+
+  json.key("surfaces").begin_array();
+  for (const SurfaceInsertion& inserted : result.surfaces) write_surface(json, inserted, last_stage);
+  json.end_array();
+  if (smoothed) write_smoothing(json, result.smoothing, result.smoothing_seconds);
+  json.end_object();
+  return json.str();
+}
+
+}  // namespace meccano

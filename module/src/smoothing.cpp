@@ -1,0 +1,576 @@
+#include <meccano/smoothing.hpp>
+
+#include <meccano/quality.hpp>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace meccano {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+// A node has up to 3 parameters; unused ones have zero columns in the Jacobian, hence zero gradient and
+// Hessian entries, so the Newton step leaves them at 0.
+using Parameters = Vector3d;
+using Jacobian = Matrix3d;
+
+constexpr double infinity = std::numeric_limits<double>::infinity();
+
+std::int64_t count_inverted(const TetMesh& mesh) {
+  std::int64_t inverted = 0;
+  for (TetId t = 0; t < mesh.num_tets(); ++t) {
+    const auto p = oriented_points(mesh, t);
+    inverted += signed_volume(p[0], p[1], p[2], p[3]) <= 0.0;
+  }
+  return inverted;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The distortion of one tet as a function of one of its vertices.
+//
+// With the vertex at x, S = A W^-1 is affine in x: dS = dx bᵀ with b = W^-T c, where c = e_k for local
+// vertex k = 1..3 and c = -(1,1,1) for vertex 0 (A's columns are p_k - p_0). So N = ||S||² has gradient
+// 2 S b and Hessian 2|b|² I, and σ = det S is linear in x with gradient cof(S) b. Writing r = √(σ² + 4δ²),
+// h'(σ) = h / r, and for f = N / (3 h^(2/3)):
+//   ∇f = f a,  a = ∇N / N - (2/3) ∇σ / r,
+//   ∇²f = f (a aᵀ + 2|b|²/N I - ∇N ∇Nᵀ / N² + (2/3) σ / r³ ∇σ ∇σᵀ).
+
+Matrix3d edge_matrix(const std::array<Vector3d, 4>& p) {
+  Matrix3d a;
+  a << p[1] - p[0], p[2] - p[0], p[3] - p[0];
+  return a;
+}
+
+Matrix3d cofactor(const Matrix3d& s) {
+  Matrix3d c;
+  c << s.col(1).cross(s.col(2)), s.col(2).cross(s.col(0)), s.col(0).cross(s.col(1));
+  return c;
+}
+
+double regularised_distortion(double frobenius_squared, double sigma, double delta) {
+  // h = (σ + r) / 2 with r = √(σ² + 4δ²); for σ < 0 the equal form 2δ² / (r - σ) avoids cancellation.
+  const double r = std::sqrt(sigma * sigma + 4.0 * delta * delta);
+  const double h = sigma >= 0.0 ? 0.5 * (sigma + r) : 2.0 * delta * delta / (r - sigma);
+  return h > 0.0 ? frobenius_squared / (3.0 * std::cbrt(h * h)) : infinity;
+}
+
+// f, ∇f and ∇²f of the tet with vertex k free (no derivatives where f is infinite).
+Distortion distortion_derivatives(const Matrix3d& s, const Matrix3d& target_inverse, int k, double delta) {
+  Distortion d;
+  const double n = s.squaredNorm();
+  const double sigma = s.determinant();
+  const double r = std::sqrt(sigma * sigma + 4.0 * delta * delta);
+  d.value = regularised_distortion(n, sigma, delta);
+  if (!std::isfinite(d.value)) return d;
+  const Vector3d b = k == 0 ? Vector3d(-target_inverse.colwise().sum().transpose()) : Vector3d(target_inverse.row(k - 1));
+  const Vector3d grad_n = 2.0 * s * b;
+  const Vector3d grad_sigma = cofactor(s) * b;
+  const Vector3d a = grad_n / n - (2.0 / 3.0) * grad_sigma / r;
+  d.gradient = d.value * a;
+  d.hessian = d.value * (a * a.transpose() + (2.0 * b.squaredNorm() / n) * Matrix3d::Identity() -
+                         grad_n * grad_n.transpose() / (n * n) +
+                         (2.0 / 3.0) * sigma / (r * r * r) * grad_sigma * grad_sigma.transpose());
+  return d;
+}
+
+// Adds f^p and its derivatives: ∇(f^p) = p f^(p-1) ∇f, ∇²(f^p) = p f^(p-1) ∇²f + p(p-1) f^(p-2) ∇f ∇fᵀ.
+void add_power(const Distortion& d, double power, Distortion& sum) {
+  if (power == 1.0) {
+    sum.value += d.value;
+    sum.gradient += d.gradient;
+    sum.hessian += d.hessian;
+    return;
+  }
+  const double f = d.value;
+  sum.value += std::pow(f, power);
+  if (!std::isfinite(f)) return;
+  const double first = power * std::pow(f, power - 1.0);
+  sum.gradient += first * d.gradient;
+  sum.hessian += first * d.hessian + (power - 1.0) * first / f * d.gradient * d.gradient.transpose();
+}
+
+// ---------------------------------------------------------------------------------------------------
+// How each node may move.
+
+enum class Freedom : std::uint8_t { fixed, space, box, surface, rim };
+
+struct NodeFreedom {
+  Freedom kind = Freedom::space;
+  std::uint8_t free_axes = 7;  // box: bit i set if coordinate i may change
+  std::uint8_t rim_axis = 0;   // rim: the parameter (0 = u, 1 = v) that runs along its side of P
+  int surface = -1;            // surface and rim: which projection, and the node's index in it
+  int index = -1;
+};
+
+// Where a node is: its position and, on a surface, its parameters and the triangle holding them.
+struct Placement {
+  Vector3d x;
+  Vector2d uv = Vector2d::Zero();
+  int triangle = -1;
+};
+
+class Smoother {
+ public:
+  Smoother(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, const SmoothingOptions& options)
+      : mesh_(mesh), surfaces_(surfaces), options_(options), stars_(vertex_to_tets(mesh)) {
+    oriented_.resize(mesh.tets.size());
+    target_inverse_.resize(mesh.tets.size());
+    const Matrix3d equilateral_inverse = equilateral_target().inverse();
+#pragma omp parallel for schedule(static)
+    for (TetId t = 0; t < mesh.num_tets(); ++t) {
+      oriented_[t] = mesh.oriented_tet(t);
+      target_inverse_[t] = options.target == SmoothingTarget::meccano
+                               ? Matrix3d(edge_matrix(oriented_computational_points(mesh, t)).inverse())
+                               : equilateral_inverse;
+    }
+    classify_nodes();
+  }
+
+  SmoothingStats run();
+
+ private:
+  static Matrix3d equilateral_target() {
+    Matrix3d w;
+    w << 1.0, 0.5, 0.5, 0.0, std::sqrt(3.0) / 2.0, std::sqrt(3.0) / 6.0, 0.0, 0.0, std::sqrt(2.0 / 3.0);
+    return w;
+  }
+
+  void classify_nodes();
+  std::vector<VertexId> free_nodes() const;
+  std::vector<std::vector<VertexId>> colour(const std::vector<VertexId>& nodes) const;
+  template <class Visit>
+  void for_each_star_vertex(VertexId v, Visit&& visit) const {
+    for (TetId t : stars_.of(v))
+      for (VertexId w : oriented_[t])
+        if (w != v) visit(w);
+  }
+
+  Matrix3d s_matrix(TetId t, VertexId v, const Vector3d& x, int& local) const {
+    std::array<Vector3d, 4> p;
+    for (int i = 0; i < 4; ++i) {
+      const VertexId w = oriented_[t][i];
+      if (w == v) local = i;
+      p[i] = w == v ? x : mesh_.points[w];
+    }
+    return edge_matrix(p) * target_inverse_[t];
+  }
+  double star_objective(VertexId v, const Vector3d& x, double delta) const;
+  Distortion star_derivatives(VertexId v, const Vector3d& x, double delta) const;
+  double choose_delta(VertexId v, double& length) const;
+
+  Placement placement(VertexId v) const;
+  Jacobian jacobian(VertexId v, const Placement& at) const;
+  bool move(VertexId v, const Placement& from, const Parameters& step, Placement& to) const;
+  bool keeps_surface_embedded(const NodeFreedom& node, const Vector2d& uv) const;
+  bool optimise(VertexId v);
+  void store(VertexId v, const Placement& at);
+  SweepRecord measure() const;
+
+  TetMesh& mesh_;
+  std::span<SurfaceProjection* const> surfaces_;
+  SmoothingOptions options_;
+  VertexTets stars_;
+  std::vector<std::array<VertexId, 4>> oriented_;
+  std::vector<Matrix3d> target_inverse_;
+  std::vector<NodeFreedom> freedom_;
+  std::vector<std::vector<int>> hints_;  // per surface and node: the triangle of φ^-1(S) last holding it
+  std::vector<std::vector<int>> triangle_start_, node_triangles_;  // per surface: node -> S_M triangles (CSR)
+  std::vector<TetId> active_tets_;
+  SmoothingStats stats_;
+  double power_ = 1.0;
+  double untangling_epsilon_ = 1e-3;  // ε / mean|σ|, raised while untangling stalls  // the exponent p of Σ η*^p: 1 while untangling, options_.power once untangled
+};
+
+void Smoother::classify_nodes() {
+  const GridPoint upper = mesh_.meccano.upper_corner();
+  freedom_.assign(mesh_.points.size(), {});
+  for (VertexId v = 0; v < mesh_.num_vertices(); ++v) {
+    NodeFreedom& node = freedom_[v];
+    for (int axis = 0; axis < 3; ++axis)
+      if (mesh_.grid[v][axis] == 0 || mesh_.grid[v][axis] == upper[axis]) node.free_axes &= static_cast<std::uint8_t>(~(1u << axis));
+    if (node.free_axes == 0) node.kind = Freedom::fixed;
+    else if (node.free_axes != 7) node.kind = Freedom::box;
+  }
+  hints_.resize(surfaces_.size());
+  triangle_start_.resize(surfaces_.size());
+  node_triangles_.resize(surfaces_.size());
+  for (int s = 0; s < static_cast<int>(surfaces_.size()); ++s) {
+    const SurfaceProjection& projection = *surfaces_[s];
+    hints_[s].assign(projection.nodes.size(), -1);
+    std::vector<int>& start = triangle_start_[s];
+    start.assign(projection.nodes.size() + 1, 0);
+    for (const auto& triangle : projection.triangles)
+      for (int i : triangle) ++start[i + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    node_triangles_[s].resize(start.back());
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (int t = 0; t < static_cast<int>(projection.triangles.size()); ++t)
+      for (int i : projection.triangles[t]) node_triangles_[s][fill[i]++] = t;
+    for (int i = 0; i < static_cast<int>(projection.nodes.size()); ++i) {
+      NodeFreedom& node = freedom_[projection.nodes[i]];
+      if (node.kind != Freedom::space) {  // on the box or on another surface: cannot follow both
+        node.kind = Freedom::fixed;
+        continue;
+      }
+      node.surface = s;
+      node.index = i;
+      node.kind = Freedom::surface;
+      if (!projection.on_rim[i]) continue;
+      // Rim parameters lie exactly on the square's sides; a corner of P lies on two and stays fixed.
+      const Vector2d& uv = projection.uv[i];
+      const bool u_on_side = uv.x() == 0.0 || uv.x() == 1.0;
+      const bool v_on_side = uv.y() == 0.0 || uv.y() == 1.0;
+      node.kind = u_on_side && v_on_side ? Freedom::fixed : Freedom::rim;
+      node.rim_axis = u_on_side ? 1 : 0;
+    }
+  }
+}
+
+std::vector<VertexId> Smoother::free_nodes() const {
+  std::vector<std::uint8_t> wanted(mesh_.points.size(), options_.mode == SmoothingMode::whole_mesh);
+  if (options_.mode == SmoothingMode::band) {
+    std::vector<VertexId> ring;
+    for (const SurfaceProjection* projection : surfaces_)
+      for (VertexId v : projection->nodes) {
+        wanted[v] = 1;
+        ring.push_back(v);
+      }
+    for (int step = 0; step < options_.band_rings; ++step) {
+      std::vector<VertexId> next;
+      for (VertexId v : ring)
+        for_each_star_vertex(v, [&](VertexId w) {
+          if (!wanted[w]) {
+            wanted[w] = 1;
+            next.push_back(w);
+          }
+        });
+      ring = std::move(next);
+    }
+  }
+  std::vector<VertexId> nodes;
+  for (VertexId v = 0; v < mesh_.num_vertices(); ++v)
+    if (wanted[v] && freedom_[v].kind != Freedom::fixed) nodes.push_back(v);
+  return nodes;
+}
+
+// Greedy colouring in node order: deterministic, and about as many colours as a node has neighbours.
+std::vector<std::vector<VertexId>> Smoother::colour(const std::vector<VertexId>& nodes) const {
+  std::vector<int> colour_of(mesh_.points.size(), -1);
+  std::vector<std::vector<VertexId>> colours;
+  std::vector<std::uint8_t> taken;
+  for (VertexId v : nodes) {
+    taken.assign(colours.size() + 1, 0);
+    for_each_star_vertex(v, [&](VertexId w) {
+      if (colour_of[w] >= 0) taken[colour_of[w]] = 1;
+    });
+    const int c = static_cast<int>(std::find(taken.begin(), taken.end(), 0) - taken.begin());
+    if (c == static_cast<int>(colours.size())) colours.emplace_back();
+    colours[c].push_back(v);
+    colour_of[v] = c;
+  }
+  return colours;
+}
+
+double Smoother::star_objective(VertexId v, const Vector3d& x, double delta) const {
+  double value = 0.0;
+  int local = 0;
+  for (TetId t : stars_.of(v)) {
+    const Matrix3d s = s_matrix(t, v, x, local);
+    value += std::pow(regularised_distortion(s.squaredNorm(), s.determinant(), delta), power_);
+  }
+  return value;
+}
+
+Distortion Smoother::star_derivatives(VertexId v, const Vector3d& x, double delta) const {
+  Distortion sum;
+  int local = 0;
+  for (TetId t : stars_.of(v)) {
+    const Matrix3d s = s_matrix(t, v, x, local);
+    add_power(distortion_derivatives(s, target_inverse_[t], local, delta), power_, sum);
+  }
+  return sum;
+}
+
+// δ from the node's star, and the star's mean edge length at the node, the scale of a sensible step.
+// Escobar et al.'s rule δ = √(ε(ε − σ_min)) when σ_min < ε, with the authors' floor 1e-4 · mean|σ| (their
+// code never lets δ reach 0). Their ε (2.2e-10 on a mesh scaled to radius 10) left the cube example
+// with 5 tets inverted after 100 sweeps: each sat in a local minimum behind S. ε = 1e-3 · mean|σ|
+// smooths the objective where the star is tangled and untangled it in 4 sweeps; on valid stars δ is
+// the floor, so the smoothing itself is unchanged.
+double Smoother::choose_delta(VertexId v, double& length) const {
+  double sigma_min = infinity, sigma_sum = 0.0;
+  int local = 0;
+  const auto star = stars_.of(v);
+  for (TetId t : star) {
+    const double sigma = s_matrix(t, v, mesh_.points[v], local).determinant();
+    sigma_min = std::min(sigma_min, sigma);
+    sigma_sum += std::abs(sigma);
+  }
+  double edges = 0.0;
+  int count = 0;
+  for_each_star_vertex(v, [&](VertexId w) {
+    edges += (mesh_.points[w] - mesh_.points[v]).norm();
+    ++count;
+  });
+  length = edges / std::max(count, 1);
+  const double scale = sigma_sum / static_cast<double>(std::max<std::size_t>(star.size(), 1));
+  const double epsilon = untangling_epsilon_ * scale;
+  const double untangling = sigma_min < epsilon ? std::sqrt(epsilon * (epsilon - sigma_min)) : 0.0;
+  return std::max(untangling, 1e-4 * scale);
+}
+
+Placement Smoother::placement(VertexId v) const {
+  Placement at{mesh_.points[v]};
+  const NodeFreedom& node = freedom_[v];
+  if (node.kind == Freedom::surface || node.kind == Freedom::rim) {
+    at.uv = surfaces_[node.surface]->uv[node.index];
+    at.triangle = surfaces_[node.surface]->surface->locate(at.uv, hints_[node.surface][node.index]).triangle;
+  }
+  return at;
+}
+
+// dx/d(parameters) at a placement.
+Jacobian Smoother::jacobian(VertexId v, const Placement& at) const {
+  const NodeFreedom& node = freedom_[v];
+  Jacobian j = Jacobian::Zero();
+  switch (node.kind) {
+    case Freedom::space:
+      return Jacobian::Identity();
+    case Freedom::box:
+      for (int axis = 0, column = 0; axis < 3; ++axis)
+        if (node.free_axes & (1u << axis)) j(axis, column++) = 1.0;
+      break;
+    case Freedom::surface:
+      j.leftCols<2>() = surfaces_[node.surface]->surface->derivative(at.triangle);
+      break;
+    case Freedom::rim:
+      j.col(0) = surfaces_[node.surface]->surface->derivative(at.triangle).col(node.rim_axis);
+      break;
+    case Freedom::fixed:
+      break;
+  }
+  return j;
+}
+
+// The placement after a step in the node's parameters; false if it would leave the node's domain
+// (the box, or the open square P for surface parameters: reaching P's boundary would put the node on
+// the rim of S).
+bool Smoother::move(VertexId v, const Placement& from, const Parameters& step, Placement& to) const {
+  const NodeFreedom& node = freedom_[v];
+  to = from;
+  switch (node.kind) {
+    case Freedom::space:
+      to.x += step;
+      return true;
+    case Freedom::box: {
+      const Box& box = mesh_.meccano.box;
+      for (int axis = 0, column = 0; axis < 3; ++axis)
+        if (node.free_axes & (1u << axis)) {
+          to.x[axis] += step[column++];
+          if (!(to.x[axis] > box.min[axis] && to.x[axis] < box.max[axis])) return false;
+        }
+      return true;
+    }
+    case Freedom::surface:
+      to.uv += step.head<2>();
+      if (!((to.uv.array() > 0.0).all() && (to.uv.array() < 1.0).all())) return false;
+      break;
+    case Freedom::rim:
+      to.uv[node.rim_axis] += step[0];
+      if (!(to.uv[node.rim_axis] > 0.0 && to.uv[node.rim_axis] < 1.0)) return false;
+      break;
+    case Freedom::fixed:
+      return false;
+  }
+  if (!keeps_surface_embedded(node, to.uv)) return false;
+  const ParametricSurface& surface = *surfaces_[node.surface]->surface;
+  const auto location = surface.locate(to.uv, from.triangle);
+  to.triangle = location.triangle;
+  to.x = surface.evaluate(location);
+  return true;
+}
+
+// Whether S_M's triangles around a surface node keep their orientation in P with the node at uv. The
+// tets alone do not guarantee it: S_M's triangles are chords of a curved S, and a triangle can fold in P
+// while both its tets stay valid; the fold then locks its neighbours in place.
+bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& uv) const {
+  const SurfaceProjection& projection = *surfaces_[node.surface];
+  const auto& start = triangle_start_[node.surface];
+  for (int k = start[node.index]; k < start[node.index + 1]; ++k) {
+    std::array<Vector2d, 3> corner;
+    const auto& triangle = projection.triangles[node_triangles_[node.surface][k]];
+    for (int c = 0; c < 3; ++c) corner[c] = triangle[c] == node.index ? uv : projection.uv[triangle[c]];
+    const Vector2d a = corner[1] - corner[0], b = corner[2] - corner[0];
+    if ((a.x() * b.y() - a.y() * b.x()) * projection.orientation <= 0.0) return false;
+  }
+  return true;
+}
+
+// A few safeguarded Newton steps on the node's star. Returns true if the node moved.
+bool Smoother::optimise(VertexId v) {
+  double length = 0.0;
+  const double delta = choose_delta(v, length);
+  const Placement start = placement(v);
+  Placement at = start;
+  for (int step = 0; step < options_.newton_steps; ++step) {
+    const Distortion star = star_derivatives(v, at.x, delta);
+    const double value = star.value;
+    const Jacobian j = jacobian(v, at);
+    const Parameters g = j.transpose() * star.gradient;
+    if (!std::isfinite(value) || g.norm() * length <= 1e-12 * value) break;
+    // Newton direction with the Hessian's eigenvalues made positive (|λ|, bounded away from 0), so the
+    // direction descends even where the objective is not convex.
+    const Eigen::SelfAdjointEigenSolver<Matrix3d> eigen(j.transpose() * star.hessian * j);
+    Parameters magnitudes = eigen.eigenvalues().cwiseAbs();
+    const double floor = std::max(1e-8 * magnitudes.maxCoeff(), std::numeric_limits<double>::min());
+    magnitudes = magnitudes.cwiseMax(floor);
+    Parameters direction =
+        -(eigen.eigenvectors() * (eigen.eigenvectors().transpose() * g).cwiseQuotient(magnitudes));
+    // At most half the star's edge length per step: the quadratic model means little beyond that.
+    const double physical = (j * direction).norm();
+    if (physical > 0.5 * length) direction *= 0.5 * length / physical;
+    const double slope = g.dot(direction);
+    Placement trial;
+    bool accepted = false;
+    for (double alpha = 1.0; alpha > 1e-6 && !accepted; alpha *= 0.5)
+      accepted = move(v, at, alpha * direction, trial) &&
+                 star_objective(v, trial.x, delta) <= value + 1e-4 * alpha * slope;
+    if (!accepted) break;
+    const double moved = (trial.x - at.x).norm();
+    at = trial;
+    if (moved <= 1e-9 * length) break;
+  }
+  if ((at.x - start.x).norm() <= 1e-8 * length) return false;
+  store(v, at);
+  return true;
+}
+
+void Smoother::store(VertexId v, const Placement& at) {
+  mesh_.points[v] = at.x;
+  const NodeFreedom& node = freedom_[v];
+  if (node.surface >= 0) {
+    surfaces_[node.surface]->uv[node.index] = at.uv;
+    hints_[node.surface][node.index] = at.triangle;
+  }
+}
+
+// Inverted tets and the target quality over the active tets (per-tet values first, then a serial sum, so
+// the result does not depend on the thread count).
+SweepRecord Smoother::measure() const {
+  std::vector<double> distortion(active_tets_.size());
+  const auto count = static_cast<std::int64_t>(active_tets_.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < count; ++i) {
+    const TetId t = active_tets_[i];
+    int local = 0;
+    const Matrix3d s = s_matrix(t, oriented_[t][0], mesh_.points[oriented_[t][0]], local);
+    const double sigma = s.determinant();
+    distortion[i] = sigma > 0.0 ? s.squaredNorm() / (3.0 * std::cbrt(sigma * sigma)) : infinity;
+  }
+  SweepRecord record;
+  record.min_quality = 1.0;
+  for (double eta : distortion) {
+    const double q = std::isfinite(eta) ? 1.0 / eta : 0.0;
+    record.inverted += q == 0.0;
+    record.min_quality = std::min(record.min_quality, q);
+    record.mean_quality += q;
+    record.objective += std::pow(eta, power_);
+  }
+  if (count > 0) record.mean_quality /= static_cast<double>(count);
+  return record;
+}
+
+SmoothingStats Smoother::run() {
+  const std::vector<VertexId> nodes = free_nodes();
+  for (VertexId v : nodes) {
+    switch (freedom_[v].kind) {
+      case Freedom::space: ++stats_.inner_nodes; break;
+      case Freedom::box: ++stats_.box_nodes; break;
+      case Freedom::surface: ++stats_.surface_nodes; break;
+      case Freedom::rim: ++stats_.rim_nodes; break;
+      case Freedom::fixed: break;
+    }
+  }
+  std::vector<std::uint8_t> active(mesh_.tets.size(), 0);
+  for (VertexId v : nodes)
+    for (TetId t : stars_.of(v)) active[t] = 1;
+  for (TetId t = 0; t < mesh_.num_tets(); ++t)
+    if (active[t]) active_tets_.push_back(t);
+  stats_.active_tets = static_cast<std::int64_t>(active_tets_.size());
+  stats_.inverted_before = count_inverted(mesh_);
+
+  const auto colours = colour(nodes);
+  stats_.colours = static_cast<int>(colours.size());
+  // A node needs another look only if it or a node of its star moved since it was last optimised.
+  std::vector<std::int64_t> last_moved(mesh_.points.size(), 0), last_optimised(mesh_.points.size(), -1);
+  std::int64_t epoch = 0;
+  int clean_sweeps = 0;
+  std::int64_t fewest_inverted = std::numeric_limits<std::int64_t>::max();
+  int stalled_sweeps = 0;
+  for (int sweep = 1; sweep <= options_.max_sweeps; ++sweep) {
+    const auto start = std::chrono::steady_clock::now();
+    std::int64_t optimised = 0;
+    for (const auto& group : colours) {
+      ++epoch;
+      const auto size = static_cast<std::int64_t>(group.size());
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : optimised)
+      for (std::int64_t i = 0; i < size; ++i) {
+        const VertexId v = group[i];
+        std::int64_t latest = last_moved[v];
+        for_each_star_vertex(v, [&](VertexId w) { latest = std::max(latest, last_moved[w]); });
+        if (latest < last_optimised[v]) continue;
+        last_optimised[v] = epoch;
+        ++optimised;
+        if (optimise(v)) last_moved[v] = epoch;
+      }
+    }
+    SweepRecord record = measure();
+    record.nodes_optimised = optimised;
+    record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    record.power = power_;
+    // The objective can only be compared with the previous sweep's if both used the same power.
+    const bool comparable = !stats_.sweeps.empty() && stats_.sweeps.back().power == power_ &&
+                            stats_.sweeps.back().inverted == 0;
+    const double previous_objective = comparable ? stats_.sweeps.back().objective : infinity;
+    stats_.sweeps.push_back(record);
+    // Untangling uses the paper's sum; once a sweep ends untangled, the next ones weigh bad tets more.
+    power_ = record.inverted == 0 ? options_.power : 1.0;
+    if (record.inverted > 0) {
+      // Stalled untangling: the tangled stars sit in local minima of a steep objective. A larger ε
+      // (a larger δ where stars are tangled) flattens it so that nodes can pass through.
+      if (record.inverted < fewest_inverted) {
+        fewest_inverted = record.inverted;
+        stalled_sweeps = 0;
+      } else if (++stalled_sweeps >= 3 && untangling_epsilon_ < 1.0) {
+        untangling_epsilon_ *= 10.0;
+        stalled_sweeps = 0;
+      }
+      continue;
+    }
+    if (clean_sweeps++ == 0 && stats_.inverted_before > 0) stats_.untangling_sweeps = sweep;
+    if (clean_sweeps >= options_.smoothing_sweeps || optimised == 0) break;
+    if (comparable && previous_objective - record.objective <= options_.tolerance * previous_objective) break;
+  }
+  stats_.inverted_after = count_inverted(mesh_);
+  return stats_;
+}
+
+}  // namespace
+
+Distortion regularised_distortion(const TetPoints& physical, const Matrix3d& target_inverse, int vertex,
+                                  double delta) {
+  return distortion_derivatives(edge_matrix(physical) * target_inverse, target_inverse, vertex, delta);
+}
+
+SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, const SmoothingOptions& options) {
+  return Smoother(mesh, surfaces, options).run();
+}
+
+}  // namespace meccano

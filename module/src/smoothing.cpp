@@ -184,8 +184,9 @@ class Smoother {
   std::vector<std::vector<int>> triangle_start_, node_triangles_;  // per surface: node -> S_M triangles (CSR)
   std::vector<TetId> active_tets_;
   SmoothingStats stats_;
-  double power_ = 1.0;
-  double untangling_epsilon_ = 1e-3;  // ε / mean|σ|, raised while untangling stalls  // the exponent p of Σ η*^p: 1 while untangling, options_.power once untangled
+  bool tangled_ = true;               // did the last sweep end with inverted tets (or none ran yet)?
+  double power_ = 1.0;                // the exponent p of Σ η*^p: 1 while tangled, options_.power after
+  double untangling_epsilon_ = 1e-3;  // ε / mean|σ|, raised while untangling stalls
 };
 
 void Smoother::classify_nodes() {
@@ -413,13 +414,16 @@ bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& u
   return true;
 }
 
-// A few safeguarded Newton steps on the node's star. Returns true if the node moved.
+// A few safeguarded Newton steps on the node's star. The new position is kept however small the move.
+// While tangled, any move counts (its neighbours get another look next sweep): untangling creeps. Once
+// smoothing, only a move beyond 1 % of the star's edge length counts, so sweeps stop revisiting regions
+// that have settled.
 bool Smoother::optimise(VertexId v) {
   double length = 0.0;
   const double delta = choose_delta(v, length);
   const Placement start = placement(v);
   Placement at = start;
-  for (int step = 0; step < options_.newton_steps; ++step) {
+  for (int step = 0, steps = tangled_ ? 2 * options_.newton_steps : options_.newton_steps; step < steps; ++step) {
     const Distortion star = star_derivatives(v, at.x, delta);
     const double value = star.value;
     const Jacobian j = jacobian(v, at);
@@ -447,9 +451,10 @@ bool Smoother::optimise(VertexId v) {
     at = trial;
     if (moved <= 1e-9 * length) break;
   }
-  if ((at.x - start.x).norm() <= 1e-8 * length) return false;
+  const double moved = (at.x - start.x).norm();
+  if (moved == 0.0) return false;
   store(v, at);
-  return true;
+  return tangled_ || moved > 1e-2 * length;
 }
 
 void Smoother::store(VertexId v, const Placement& at) {
@@ -541,7 +546,8 @@ SmoothingStats Smoother::run() {
     const double previous_objective = comparable ? stats_.sweeps.back().objective : infinity;
     stats_.sweeps.push_back(record);
     // Untangling uses the paper's sum; once a sweep ends untangled, the next ones weigh bad tets more.
-    power_ = record.inverted == 0 ? options_.power : 1.0;
+    tangled_ = record.inverted > 0;
+    power_ = tangled_ ? 1.0 : options_.power;
     if (record.inverted > 0) {
       // Stalled untangling: the tangled stars sit in local minima of a steep objective. A larger ε
       // (a larger δ where stars are tangled) flattens it so that nodes can pass through.

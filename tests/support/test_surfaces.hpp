@@ -12,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,9 @@ struct SurfaceCase {
   Box box;
   double resolution;
 };
+
+// GoogleTest prints a parameter by its name rather than as a dump of its bytes.
+inline void PrintTo(const SurfaceCase& c, std::ostream* os) { *os << c.name; }
 
 // Every entry of named_test_surfaces(n) in the unit cube at l_r = 1/16 and 1/32, in a 2x1x1 box at 1/16
 // and in a flat 1 x 1.5 x 0.5 box at 1/40; with `perturbed`, also perturbed (seed 7) at 1/24.

@@ -25,10 +25,10 @@
 //          chord-length spacing of the projection, which ignores the volume mesh behind it.
 // Sweeps   non-linear Gauss-Seidel. Nodes are coloured so that no two nodes of one colour share a tet;
 //          the nodes of a colour are optimised in parallel, so the result does not depend on the thread
-//          count. A node is skipped when neither it nor any node of its star moved since it was last
-//          optimised. The sweeps stop after `smoothing_sweeps` sweeps that end with no inverted tet (the
-//          authors' rule), or earlier once such a sweep lowers the objective by less than `tolerance`
-//          (relative), or after `max_sweeps` sweeps.
+//          count. A node is skipped when neither it nor any node of its star moved (by more than 1 % of
+//          its star's edge length) since it was last optimised. The sweeps stop after `smoothing_sweeps`
+//          sweeps that end with no inverted tet (the authors' rule), or earlier once such a sweep lowers
+//          the objective by less than `tolerance` (relative), or after `max_sweeps` sweeps.
 // Modes    whole mesh (the paper), or a band: only nodes within `band_rings` edge rings of an S_M node.
 // Output   the moved mesh and the surfaces' updated parameters; statistics per sweep. `untangled` is false
 //          if inverted tets remain: the caller must not present that mesh as a result.
@@ -53,9 +53,9 @@ struct SmoothingOptions {
   int band_rings = 3;
   int max_sweeps = 100;
   int smoothing_sweeps = 20;
-  double tolerance = 1e-4;
+  double tolerance = 1e-3;
   double power = 4.0;    // p of Σ η*^p once untangled; 1 is the paper's objective
-  int newton_steps = 4;  // per node and sweep
+  int newton_steps = 2;  // per node and sweep
 };
 
 struct SweepRecord {

@@ -126,7 +126,8 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
   if (!smoothing.untangled())
     throw MeshingError("smoothing could not untangle the mesh: " + std::to_string(smoothing.inverted_after) +
                        " tets are still inverted after " + std::to_string(smoothing.sweeps.size()) +
-                       " sweeps; try a smaller resolution or the whole-mesh mode");
+                       " sweeps; try a smaller resolution" +
+                       (options.smoothing.mode == SmoothingMode::band ? " or the whole-mesh mode" : ""));
   check_stage(result.mesh, "smoothing");
   result.quality_after_smoothing = summarize_quality(result.mesh);
   return result;

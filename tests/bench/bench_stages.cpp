@@ -87,10 +87,10 @@ int main(int argc, char** argv) {
                 sum / count);
   }
 
-  std::printf("\n| %-22s | %6s | %6s | %5s | %6s | %5s | %5s | %5s | %6s | %5s | %5s | %5s | %7s | %6s |\n",
+  std::printf("\n| %-22s | %6s | %6s | %5s | %6s | %5s | %5s | %5s | %6s | %5s | %5s | %5s | %5s | %7s | %6s |\n",
               "S_M (l_r = 1/32)", "faces", "passes", "ext", "corbel", "fill", "left", "2face", "2rim",
-              "div", "cross", "max d", "S_M/S", "ms");
-  std::printf("|------------------------|--------|--------|-------|--------|-------|-------|-------|--------|-------|-------|-------|---------|--------|\n");
+              "div", "chord", "cross", "max d", "S_M/S", "ms");
+  std::printf("|------------------------|--------|--------|-------|--------|-------|-------|-------|--------|-------|-------|-------|-------|---------|--------|\n");
   for (const auto& named : meccano::testing::named_test_surfaces(24)) {
     meccano::TetMesh mesh = meccano::make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
     const meccano::TriangleSurface& patch = named.surfaces.front();
@@ -110,13 +110,13 @@ int main(int argc, char** argv) {
     for (const auto& t : faces.triangles)
       for (meccano::VertexId v : t)
         largest = std::max(largest, std::sqrt(patch_tree.closest_point(mesh.points[v]).squared_distance));
-    std::printf("| %-22s | %6lld | %6d | %5lld | %6lld | %5lld | %5lld | %5lld | %6lld | %5lld | %5lld | %5.2f | %7.2f | %6.1f |\n",
+    std::printf("| %-22s | %6lld | %6d | %5lld | %6lld | %5lld | %5lld | %5lld | %6lld | %5lld | %5lld | %5lld | %5.2f | %7.2f | %6.1f |\n",
                 named.name.c_str(), static_cast<long long>(h.faces), h.passes,
                 static_cast<long long>(h.extension_faces), static_cast<long long>(h.corbels),
                 static_cast<long long>(h.reflex_corners_filled), static_cast<long long>(h.reflex_corners_left),
                 static_cast<long long>(h.tets_with_two_faces), static_cast<long long>(h.triangles_with_two_rim_edges),
-                static_cast<long long>(h.dividing_edges), static_cast<long long>(h.cross_surface_edges),
-                largest / resolution, area_of(mesh.points, faces.triangles) / area_of(patch.points, patch.triangles), ms);
+                static_cast<long long>(h.dividing_edges), static_cast<long long>(h.chord_edges),
+                static_cast<long long>(h.cross_surface_edges), largest / resolution, area_of(mesh.points, faces.triangles) / area_of(patch.points, patch.triangles), ms);
   }
 
   std::printf("\n| %8s | %8s | %10s | %6s | %12s | %14s | %10s |\n", "l_r", "S_M faces", "Hausdorff", "rate",

@@ -3,6 +3,8 @@
 #include <meccano/error.hpp>
 #include <meccano/mesh_check.hpp>
 
+#include <omp.h>
+
 #include <chrono>
 #include <sstream>
 
@@ -70,7 +72,8 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
       SurfaceInsertion& inserted = result.surfaces[s];
       if (round > 0 && check_surface_approximation(result.mesh, inserted.volumetric, s).healed()) continue;
       const auto start = std::chrono::steady_clock::now();
-      inserted.healing_stats = approximate_surface(result.mesh, inserted.volumetric, surfaces[s], trees[s], s, {}, other_regions(s));
+      inserted.healing_stats = approximate_surface(result.mesh, inserted.volumetric, surfaces[s], trees[s], s,
+                                                   options.approximation, other_regions(s));
       inserted.approximation_seconds += seconds_since(start);
       healed_any = true;
       const auto& h = inserted.healing_stats;
@@ -133,10 +136,25 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
   return result;
 }
 
+// Sets OpenMP's thread count for the calling thread's parallel regions and restores it on exit.
+class ThreadCount {
+ public:
+  explicit ThreadCount(int threads) : previous_(omp_get_max_threads()) {
+    if (threads > 0) omp_set_num_threads(threads);
+  }
+  ~ThreadCount() { omp_set_num_threads(previous_); }
+  ThreadCount(const ThreadCount&) = delete;
+  ThreadCount& operator=(const ThreadCount&) = delete;
+
+ private:
+  int previous_;
+};
+
 }  // namespace
 
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();
+  const ThreadCount threads(options.threads);
   InsertionResult result = run_stages(std::move(mesh), surfaces, options);
   result.seconds = seconds_since(pipeline_start);
   return result;
@@ -160,6 +178,29 @@ MeshGroups output_groups(const InsertionResult& result) {
            interface_faces(result.mesh, inserted.volumetric, s, inserted.healing_stats.side).faces});
   }
   return groups;
+}
+
+std::vector<SurfaceInterface> surface_interfaces(const InsertionResult& result) {
+  std::vector<SurfaceInterface> interfaces;
+  const TetMesh& mesh = result.mesh;
+  for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s) {
+    const SurfaceInsertion& inserted = result.surfaces[s];
+    if (inserted.healing_stats.side == 0) continue;
+    const InterfaceFaces oriented = interface_faces(mesh, inserted.volumetric, s, inserted.healing_stats.side);
+    SurfaceInterface& interface = interfaces.emplace_back();
+    interface.name = inserted.name;
+    interface.tag = interface_tag(s);
+    interface.faces.reserve(oriented.faces.size());
+    for (std::size_t i = 0; i < oriented.faces.size(); ++i) {
+      const FaceRef behind = oriented.faces[i];
+      const TetId front = mesh.neighbours[behind.tet][behind.local_face];
+      const auto& v = oriented.triangles[i];
+      const Eigen::Vector3d normal =
+          (mesh.points[v[1]] - mesh.points[v[0]]).cross(mesh.points[v[2]] - mesh.points[v[0]]).normalized();
+      interface.faces.push_back({v, normal, behind, {front, mesh.face_towards(front, behind.tet)}});
+    }
+  }
+  return interfaces;
 }
 
 }  // namespace meccano

@@ -682,11 +682,18 @@ HealingStats approximate_surface(TetMesh& mesh, TetRegion& volumetric, const Tri
                                  std::vector<TetRegion*> other_regions) {
   const FaceTag tag = interface_tag(index);
   const SideClassifier sides(surface, tree);
+  std::vector<int> sides_to_try;
+  switch (options.side_rule) {
+    case SideRule::positive_first: sides_to_try = {+1, -1}; break;
+    case SideRule::negative_first: sides_to_try = {-1, +1}; break;
+    case SideRule::positive_only: sides_to_try = {+1}; break;
+    case SideRule::negative_only: sides_to_try = {-1}; break;
+  }
   std::string failures;
-  for (int side : {+1, -1}) {
+  for (int side : sides_to_try) {
     HealingStats stats;
     stats.side = side;
-    stats.attempts = side == +1 ? 1 : 2;
+    stats.attempts = side == sides_to_try.front() ? 1 : 2;
     const std::string failure = heal_side(mesh, volumetric, sides, tag, side, options, other_regions, stats);
     if (failure.empty()) {
       stats.first_side_failure = failures;

@@ -9,7 +9,9 @@
 //             (smoothing.hpp); a mesh that stays tangled is an error, never a result.
 //          The surfaces are taken one after the other; a later surface's refinement keeps the earlier
 //          surfaces' regions in step (bisection does not change a region's point set).
-// Output   the refined mesh, each surface's V_M, per-stage statistics and timings.
+// Output   the refined mesh, each surface's V_M, per-stage statistics and timings; surface_interfaces()
+//          lists each surface's faces with the tets on both sides, output_groups() the named groups the
+//          file writers take.
 // Progress a callback receives one line per stage with counts.
 #pragma once
 
@@ -22,6 +24,7 @@
 #include <meccano/tet_mesh.hpp>
 #include <meccano/volumetric_approximation.hpp>
 
+#include <array>
 #include <functional>
 #include <span>
 #include <string>
@@ -34,8 +37,10 @@ enum class Stage { volumetric, approximation, projection, smoothing };
 struct InsertionOptions {
   double resolution = 0.0;  // l_r, a length in physical units
   Stage last_stage = Stage::smoothing;
-  SmoothingOptions smoothing;
-  std::function<void(const std::string&)> progress;
+  SurfaceApproximationOptions approximation;  // side rule, healing pass limit
+  SmoothingOptions smoothing;                 // SUS mode, target and limits
+  int threads = 0;                            // OpenMP threads for this call; 0 = OpenMP's default
+  std::function<void(const std::string&)> progress;  // one line per stage, with counts
 };
 
 struct SurfaceInsertion {
@@ -70,5 +75,25 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
 // `domain`, the box sides, `volumetric_NAME` for every surface's V_M, and `interface_NAME` for every
 // surface's S_M (once built), oriented like the surface.
 MeshGroups output_groups(const InsertionResult& result);
+
+// What a solver needs to impose a condition on an inserted surface: each face of S_M once, with the
+// tets on both sides. The vertex order and `normal` agree with the surface's normals (right-hand rule);
+// the normal points out of `negative` (the tet on S's negative side) into `positive`. Box-side faces
+// carry box_side_tag in mesh.face_tags; every tet belongs to the one volume, `domain`.
+struct InterfaceFace {
+  std::array<VertexId, 3> vertices;
+  Eigen::Vector3d normal;  // unit
+  FaceRef negative;        // the tet behind the face and its local face
+  FaceRef positive;        // the tet in front of it
+};
+
+struct SurfaceInterface {
+  std::string name;
+  FaceTag tag;  // interface_tag(index) in mesh.face_tags
+  std::vector<InterfaceFace> faces;
+};
+
+// One entry per surface whose S_M was built (every surface once the approximation stage has run).
+std::vector<SurfaceInterface> surface_interfaces(const InsertionResult& result);
 
 }  // namespace meccano

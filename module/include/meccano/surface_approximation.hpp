@@ -34,8 +34,8 @@
 //          each pass re-applying steps 2-3 (component and hole clean-up, axis-parallel rim).
 //          Refinement is Kossaczky bisection: the mesh stays conforming; V_M and the other surfaces'
 //          regions follow through the child callback; S_M follows as a face tag.
-// Side     +1 (the side S's normals point to) is tried first; if healing fails, the other side is
-//          tried on the mesh as refined so far.
+// Side     by default +1 (the side S's normals point to) is tried first; if healing fails, the other
+//          side is tried on the mesh as refined so far (SideRule chooses the order or one side only).
 // Output   S_M as the faces tagged interface_tag(k), and the statistics of every rule.
 // Invariants on return (check_surface_approximation): S_M is one connected manifold disk (Euler
 //          characteristic 1, one rim loop, no pinched node), every rim edge is axis-parallel, no corbel,
@@ -58,8 +58,13 @@
 
 namespace meccano {
 
+// Which side of S S_M is built on: S's normals point to the positive side. The *_first rules try the
+// other side when healing fails on the first; the *_only rules fail instead.
+enum class SideRule { positive_first, negative_first, positive_only, negative_only };
+
 struct SurfaceApproximationOptions {
   int max_healing_passes = 60;
+  SideRule side_rule = SideRule::positive_first;
 };
 
 struct HealingStats {

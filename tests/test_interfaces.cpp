@@ -1,0 +1,137 @@
+// The library call a solver uses (pipeline.hpp): insert_surfaces with its options, and
+// surface_interfaces, each surface's faces with the tets on both sides and one consistent normal.
+
+#include <meccano/cube_meccano.hpp>
+#include <meccano/geometry.hpp>
+#include <meccano/pipeline.hpp>
+
+#include <test_surfaces.hpp>
+
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <set>
+
+namespace meccano {
+namespace {
+
+using Eigen::Vector3d;
+
+InsertionResult insert(std::span<const TriangleSurface> surfaces, InsertionOptions options) {
+  return insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), surfaces, options);
+}
+
+InsertionOptions coarse() {
+  InsertionOptions options;
+  options.resolution = 1.0 / 16;
+  return options;
+}
+
+std::array<VertexId, 3> sorted(std::array<VertexId, 3> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+// Unit normal of S's triangle nearest to x.
+Vector3d surface_normal_near(const TriangleSurface& surface, const TriangleBVH& tree, const Vector3d& x) {
+  const auto& t = surface.triangles[tree.closest_point(x).triangle];
+  const Vector3d& a = surface.points[t[0]];
+  return (surface.points[t[1]] - a).cross(surface.points[t[2]] - a).normalized();
+}
+
+// Every face: both tets hold it, the normal follows the vertex order and points from `negative` into
+// `positive`, and agrees with S's normal there; each tagged face is listed once.
+void expect_consistent(const InsertionResult& result, const SurfaceInterface& interface, const TriangleSurface& surface) {
+  const TetMesh& mesh = result.mesh;
+  const TriangleBVH tree(surface);
+  std::set<std::array<VertexId, 3>> seen;
+  double agreement = 0.0, area = 0.0;
+  for (const InterfaceFace& face : interface.faces) {
+    const auto key = sorted(face.vertices);
+    ASSERT_TRUE(seen.insert(key).second) << "a face is listed twice";
+    for (const FaceRef side : {face.negative, face.positive}) {
+      ASSERT_NE(side.tet, no_tet);
+      EXPECT_EQ(mesh.face_tags[side.tet][side.local_face], interface.tag);
+      EXPECT_EQ(sorted(mesh.outward_face(side.tet, side.local_face)), key);
+    }
+    EXPECT_EQ(mesh.outward_face(face.negative.tet, face.negative.local_face), face.vertices)
+        << "the normal must point out of the negative tet";
+    const Vector3d& a = mesh.points[face.vertices[0]];
+    const Vector3d area_normal = (mesh.points[face.vertices[1]] - a).cross(mesh.points[face.vertices[2]] - a);
+    EXPECT_NEAR((area_normal.normalized() - face.normal).norm(), 0.0, 1e-12);
+    const Vector3d centroid = (a + mesh.points[face.vertices[1]] + mesh.points[face.vertices[2]]) / 3;
+    const Vector3d& apex = mesh.points[mesh.tets[face.positive.tet][face.positive.local_face]];
+    EXPECT_GT((apex - centroid).dot(face.normal), 0.0) << "the positive tet lies behind the face";
+    agreement += area_normal.norm() * face.normal.dot(surface_normal_near(surface, tree, centroid));
+    area += area_normal.norm();
+  }
+  std::int64_t tagged = 0;
+  for (TetId t = 0; t < mesh.num_tets(); ++t)
+    tagged += std::count(mesh.face_tags[t].begin(), mesh.face_tags[t].end(), interface.tag);
+  EXPECT_EQ(2 * static_cast<std::int64_t>(interface.faces.size()), tagged);
+  EXPECT_GT(agreement / area, 0.95) << "area-weighted cosine between the faces' normals and S's";
+}
+
+TEST(SurfaceInterfaces, TwoStackedSurfacesGiveTwoConsistentInterfaces) {
+  std::vector<TriangleSurface> surfaces = testing::stacked_pair(16);
+  surfaces[0].name = "lower";
+  surfaces[1].name = "upper";
+  const InsertionResult result = insert(surfaces, coarse());
+  const auto interfaces = surface_interfaces(result);
+  ASSERT_EQ(interfaces.size(), 2u);
+  EXPECT_EQ(interfaces[0].name, "lower");
+  EXPECT_EQ(interfaces[1].name, "upper");
+  EXPECT_NE(interfaces[0].tag, interfaces[1].tag);
+  for (int s = 0; s < 2; ++s) {
+    SCOPED_TRACE(interfaces[s].name);
+    EXPECT_FALSE(interfaces[s].faces.empty());
+    expect_consistent(result, interfaces[s], surfaces[s]);
+  }
+}
+
+TEST(SurfaceInterfaces, TheNegativeSideRuleBuildsSMBelowSAndKeepsTheNormalsOfS) {
+  const std::vector<TriangleSurface> surfaces{testing::paper_like_patch(16)};
+  InsertionOptions options = coarse();
+  options.approximation.side_rule = SideRule::negative_only;
+  const InsertionResult result = insert(surfaces, options);
+  EXPECT_EQ(result.surfaces[0].healing_stats.side, -1);
+  const auto interfaces = surface_interfaces(result);
+  ASSERT_EQ(interfaces.size(), 1u);
+  expect_consistent(result, interfaces[0], surfaces[0]);
+}
+
+TEST(SurfaceInterfaces, NoneBeforeTheApproximationStage) {
+  const std::vector<TriangleSurface> surfaces{testing::paper_like_patch(16)};
+  InsertionOptions options = coarse();
+  options.last_stage = Stage::volumetric;
+  EXPECT_TRUE(surface_interfaces(insert(surfaces, options)).empty());
+}
+
+TEST(InsertionOptions, TheThreadCountChangesNothingAndIsRestored) {
+  const std::vector<TriangleSurface> surfaces{testing::spherical_cap(12)};
+  InsertionOptions options = coarse();
+  const int before = omp_get_max_threads();
+  options.threads = 1;
+  const InsertionResult one = insert(surfaces, options);
+  EXPECT_EQ(omp_get_max_threads(), before);
+  options.threads = 2;
+  const InsertionResult two = insert(surfaces, options);
+  ASSERT_EQ(one.mesh.num_tets(), two.mesh.num_tets());
+  EXPECT_EQ(one.mesh.tets, two.mesh.tets);
+  EXPECT_EQ(one.mesh.points, two.mesh.points);
+}
+
+TEST(InsertionOptions, ProgressReportsEveryStage) {
+  const std::vector<TriangleSurface> surfaces{testing::paper_like_patch(16)};
+  InsertionOptions options = coarse();
+  std::vector<std::string> lines;
+  options.progress = [&](const std::string& line) { lines.push_back(line); };
+  insert(surfaces, options);
+  for (const char* stage : {"volumetric", "approximation", "projection", "smoothing"})
+    EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.rfind(stage, 0) == 0; }))
+        << stage;
+}
+
+}  // namespace
+}  // namespace meccano

@@ -88,6 +88,8 @@ std::string insertion_report_json(const InsertionResult& result, Stage last_stag
     json.key("min_dihedral_deg").value(final_quality.min_dihedral_deg);
     json.key("max_dihedral_deg").value(final_quality.max_dihedral_deg);
   }
+  // Stage seconds are those of the attempt that succeeded; seconds.total counts both.
+  if (!result.side_retry.empty()) json.key("side_retry").value(result.side_retry);
 
   double stage_seconds[4] = {0, 0, 0, result.smoothing_seconds};
   for (const SurfaceInsertion& inserted : result.surfaces) {

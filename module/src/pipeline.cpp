@@ -29,7 +29,8 @@ void check_stage(const TetMesh& mesh, const char* stage) {
   if (!check.ok()) throw MeshingError(std::string("mesh invalid after the ") + stage + " stage: " + check.summary());
 }
 
-InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
+InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options,
+                           std::span<const SideRule> side_rules) {
   InsertionResult result;
   result.mesh = std::move(mesh);
   if (static_cast<int>(surfaces.size()) > max_interfaces)
@@ -72,8 +73,10 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
       SurfaceInsertion& inserted = result.surfaces[s];
       if (round > 0 && check_surface_approximation(result.mesh, inserted.volumetric, s).healed()) continue;
       const auto start = std::chrono::steady_clock::now();
+      SurfaceApproximationOptions approximation = options.approximation;
+      approximation.side_rule = side_rules[s];
       inserted.healing_stats = approximate_surface(result.mesh, inserted.volumetric, surfaces[s], trees[s], s,
-                                                   options.approximation, other_regions(s));
+                                                   approximation, other_regions(s));
       inserted.approximation_seconds += seconds_since(start);
       healed_any = true;
       const auto& h = inserted.healing_stats;
@@ -126,11 +129,7 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
          " colours; ", smoothing.inverted_before, " inverted tets before, ", smoothing.inverted_after, " after ",
          smoothing.sweeps.size(), " sweeps (untangled after ", smoothing.untangling_sweeps, "); quality min ",
          last.min_quality, " mean ", last.mean_quality);
-  if (!smoothing.untangled())
-    throw MeshingError("smoothing could not untangle the mesh: " + std::to_string(smoothing.inverted_after) +
-                       " tets are still inverted after " + std::to_string(smoothing.sweeps.size()) +
-                       " sweeps; try a smaller resolution" +
-                       (options.smoothing.mode == SmoothingMode::band ? " or the whole-mesh mode" : ""));
+  if (!smoothing.untangled()) return result;  // the caller may retry, or reports the failure
   check_stage(result.mesh, "smoothing");
   result.quality_after_smoothing = summarize_quality(result.mesh);
   return result;
@@ -150,12 +149,61 @@ class ThreadCount {
   int previous_;
 };
 
+std::string untangling_failure(const InsertionResult& result, const InsertionOptions& options) {
+  return "smoothing could not untangle the mesh: " + std::to_string(result.smoothing.inverted_after) +
+         " tets are still inverted after " + std::to_string(result.smoothing.sweeps.size()) +
+         " sweeps; try a smaller resolution" +
+         (options.smoothing.mode == SmoothingMode::band ? " or the whole-mesh mode" : "");
+}
+
+// The side rules of a second attempt: each surface with a node in an inverted tet, if its rule lets
+// it change sides, builds S_M on the other side only. Empty if no surface may change.
+std::vector<SideRule> other_side_rules(const InsertionResult& result, std::span<const SideRule> rules) {
+  const TetMesh& mesh = result.mesh;
+  std::vector<int> surface_of(mesh.points.size(), -1);
+  for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s)
+    for (VertexId v : result.surfaces[s].projection.nodes) surface_of[v] = s;
+  std::vector<SideRule> retry(rules.begin(), rules.end());
+  bool changed = false;
+  for (TetId t = 0; t < mesh.num_tets(); ++t) {
+    const auto p = oriented_points(mesh, t);
+    if (signed_volume(p[0], p[1], p[2], p[3]) > 0.0) continue;
+    for (VertexId v : mesh.tets[t]) {
+      const int s = surface_of[v];
+      if (s < 0 || retry[s] != rules[s]) continue;
+      const int side = result.surfaces[s].healing_stats.side;
+      if (rules[s] == SideRule::positive_first || rules[s] == SideRule::negative_first) {
+        retry[s] = side > 0 ? SideRule::negative_only : SideRule::positive_only;
+        changed = true;
+      }
+    }
+  }
+  return changed ? retry : std::vector<SideRule>{};
+}
+
 }  // namespace
 
+// A surface whose S_M cannot be untangled on one side of S may be on the other: the whole insertion is
+// run again from the input mesh with those surfaces' S_M on their other side, as healing itself does.
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();
   const ThreadCount threads(options.threads);
-  InsertionResult result = run_stages(std::move(mesh), surfaces, options);
+  const std::vector<SideRule> rules(surfaces.size(), options.approximation.side_rule);
+  InsertionResult result = run_stages(mesh, surfaces, options, rules);
+  if (options.last_stage == Stage::smoothing && !surfaces.empty() && !result.smoothing.untangled()) {
+    const std::string failure = untangling_failure(result, options);
+    const std::vector<SideRule> retry = other_side_rules(result, rules);
+    if (retry.empty()) throw MeshingError(failure);
+    report(options, "retrying with S_M on the other side of the surfaces next to inverted tets (", failure, ")");
+    try {
+      result = run_stages(std::move(mesh), surfaces, options, retry);
+    } catch (const MeshingError& other_side) {
+      throw MeshingError(failure + "; on the other side: " + other_side.what());
+    }
+    if (!result.smoothing.untangled())
+      throw MeshingError(failure + "; on the other side: " + untangling_failure(result, options));
+    result.side_retry = failure;
+  }
   result.seconds = seconds_since(pipeline_start);
   return result;
 }

@@ -439,8 +439,7 @@ bool Smoother::optimise(VertexId v) {
     if (!std::isfinite(value) || g.norm() * length <= 1e-12 * value) break;
     // Newton direction with the Hessian's eigenvalues made positive (|λ|, bounded away from 0), so the
     // direction descends even where the objective is not convex.
-    Eigen::SelfAdjointEigenSolver<Matrix3d> eigen;
-    eigen.computeDirect(j.transpose() * star.hessian * j);
+    const Eigen::SelfAdjointEigenSolver<Matrix3d> eigen(j.transpose() * star.hessian * j);
     Parameters magnitudes = eigen.eigenvalues().cwiseAbs();
     const double floor = std::max(1e-8 * magnitudes.maxCoeff(), std::numeric_limits<double>::min());
     magnitudes = magnitudes.cwiseMax(floor);

@@ -6,7 +6,9 @@
 //             are built, any S_M that a later surface's refinement disturbed is healed again;
 //          3. projection of each S_M onto its surface (projection.hpp);
 //          4. simultaneous untangling and smoothing of the whole mesh or of a band around the surfaces
-//             (smoothing.hpp); a mesh that stays tangled is an error, never a result.
+//             (smoothing.hpp). If tets stay inverted, the insertion is run again with the S_M of the
+//             surfaces next to them on the other side of S (when the side rule allows it); a mesh that
+//             stays tangled is an error, never a result.
 //          The surfaces are taken one after the other; a later surface's refinement keeps the earlier
 //          surfaces' regions in step (bisection does not change a region's point set).
 // Output   the refined mesh, each surface's V_M, per-stage statistics and timings; surface_interfaces()
@@ -62,12 +64,14 @@ struct InsertionResult {
   QualitySummary quality_before_smoothing;  // right after projection (tets may be inverted)
   QualitySummary quality_after_smoothing;
   double seconds = 0.0;                     // the whole insertion
+  std::string side_retry;  // why the insertion was run again with S_M on the other side (empty if not)
 };
 
 // The report of an insertion as a JSON document: tets, nodes, inverted (after smoothing), quality
 // before and after smoothing (meccano and equilateral min/mean/std, inverted, dihedral range),
 // min_dihedral_deg and max_dihedral_deg of the result, seconds per stage and in total, and per surface
-// the statistics of every stage. Keys of stages not run are left out.
+// the statistics of every stage, and side_retry if the insertion had to be run again (the stage seconds
+// are then those of the second run). Keys of stages not run are left out.
 std::string insertion_report_json(const InsertionResult& result, Stage last_stage);
 
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options);

@@ -1,10 +1,12 @@
-// The meccano-immerse command line: exit statuses, messages, outputs read back by the Gmsh library,
-// and bad input that must fail with its own message and leave no file behind.
+// The meccano-immerse command line: exit statuses, messages, outputs read back by the Gmsh library (MSH,
+// Medit) and the tests' VTU reader, and bad input that must fail with its own message and leave no file
+// behind.
 
 #include <meccano/geometry.hpp>
 #include <meccano/surface.hpp>
 
 #include <test_surfaces.hpp>
+#include <vtu_reader.hpp>
 
 #include <gmsh.h>
 #include <gtest/gtest.h>
@@ -62,6 +64,12 @@ class CliTest : public ::testing::Test {
     return path(name);
   }
 
+  // The stacked pair of test surfaces as lower.obj and upper.obj.
+  std::array<std::string, 2> write_stacked_pair() const {
+    const auto pair = testing::stacked_pair(8);
+    return {write_obj("lower.obj", pair[0]), write_obj("upper.obj", pair[1])};
+  }
+
   bool only_inputs_in_directory(std::size_t inputs) const {
     return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir_), fs::directory_iterator())) == inputs;
   }
@@ -97,6 +105,8 @@ TEST_F(CliTest, HelpExitsZeroWithExamples) {
   EXPECT_EQ(run.status, 0);
   EXPECT_NE(run.output.find("--box X0,Y0,Z0,X1,Y1,Z1"), std::string::npos);
   EXPECT_NE(run.output.find("Examples:"), std::string::npos);
+  for (const char* text : {"--msh-version V", ".vtu", ".mesh", "--output fault.vtu"})
+    EXPECT_NE(run.output.find(text), std::string::npos) << text;
 }
 
 TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
@@ -107,7 +117,11 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
       {"--box 0,0,0,1,x,1 --output " + path("a.msh"), "is not a finite number"},
       {"--box 0,0,0,1,1,1 --level -1 --output " + path("a.msh"), "--level must be between"},
       {"--box 0,0,0,1,1,1 --frobnicate --output " + path("a.msh"), "unknown option"},
-      {"--box 0,0,0,1,1,1 --output " + path("a.vtk"), "only .msh output"},
+      {"--box 0,0,0,1,1,1 --output " + path("a.vtk"), "unknown format; the extensions are .msh"},
+      {"--box 0,0,0,1,1,1 --output " + path("a.msh") + " --output " + path("a.vtk"), "a.vtk: unknown format"},
+      {"--box 0,0,0,1,1,1 --msh-version 3 --output " + path("a.msh"), "the versions are 4.1 and 2.2"},
+      {"--box 0,0,0,1,1,1 --output " + path("a.msh") + " --msh-version 2.2 --output " + path("a.vtu"),
+       "--msh-version applies to the .msh outputs after it, and none follows"},
       {"--box 0,0,0,1,1,1 --surface s.obj --stage volumetric --output " + path("a.msh"), "--surface needs --resolution"},
       {"--box 0,0,0,1,1,1 --resolution 0.1 --output " + path("a.msh"), "need at least one --surface"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0 --stage volumetric --output " + path("a.msh"),
@@ -153,9 +167,7 @@ TEST_F(CliTest, ProgressReportsEachStageWithCounts) {
 }
 
 TEST_F(CliTest, VolumetricStageWritesOneGroupPerSurface) {
-  const auto pair = testing::stacked_pair(8);
-  const std::string lower = write_obj("lower.obj", pair[0]);
-  const std::string upper = write_obj("upper.obj", pair[1]);
+  const auto [lower, upper] = write_stacked_pair();
   const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + lower + " --surface " + upper +
                           ":top --resolution 0.08 --stage volumetric --quiet --output " + path("vm.msh"));
   ASSERT_EQ(run.status, 0) << run.output;
@@ -168,9 +180,7 @@ TEST_F(CliTest, VolumetricStageWritesOneGroupPerSurface) {
 }
 
 TEST_F(CliTest, ApproximationStageWritesOneInterfaceGroupPerSurface) {
-  const auto pair = testing::stacked_pair(8);
-  const std::string lower = write_obj("lower.obj", pair[0]);
-  const std::string upper = write_obj("upper.obj", pair[1]);
+  const auto [lower, upper] = write_stacked_pair();
   const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + lower + ":bottom --surface " + upper +
                              ":top --resolution 0.06 --stage approximation --output " + path("sm.msh"));
   ASSERT_EQ(run.status, 0) << run.output;
@@ -240,6 +250,7 @@ TEST_F(CliTest, FullPipelineWritesAnUntangledMeshAReportAndHistograms) {
   }
   const auto sizes = group_sizes(path("mesh.msh"));
   EXPECT_GT(sizes.count("interface_fault") ? sizes.at("interface_fault") : 0u, 0u);
+  EXPECT_EQ(sizes.count("volumetric_fault"), 0u) << "V_M is for the inspection stages only";
 
   std::ifstream report_file(path("report.json"));
   const std::string report((std::istreambuf_iterator<char>(report_file)), std::istreambuf_iterator<char>());
@@ -289,6 +300,68 @@ TEST_F(CliTest, BadSurfacesFailWithTheirOwnMessageAndWriteNothing) {
   EXPECT_EQ(missing.status, 1);
   EXPECT_NE(missing.output.find("none.obj"), std::string::npos) << missing.output;
   EXPECT_TRUE(only_inputs_in_directory(5));
+}
+
+std::string file_text(const std::string& file) {
+  std::ifstream in(file);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Triangles per Medit reference, as Gmsh reads them (one entity per reference).
+std::map<int, std::size_t> medit_triangles_per_reference(const std::string& file) {
+  gmsh::initialize();
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::open(file);
+  std::map<int, std::size_t> counts;
+  gmsh::vectorpair surfaces;
+  gmsh::model::getEntities(surfaces, 2);
+  for (const auto& [dim, tag] : surfaces) {
+    std::vector<std::size_t> elements, nodes;
+    gmsh::model::mesh::getElementsByType(2, elements, nodes, tag);
+    counts[tag] = elements.size();
+  }
+  gmsh::finalize();
+  return counts;
+}
+
+// Every format from one run of the whole method: the same groups with the same counts in each.
+TEST_F(CliTest, WritesEveryFormatInOneRunWithBothInterfaces) {
+  const auto [lower, upper] = write_stacked_pair();
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + lower + ":bottom --surface " + upper +
+                             ":top --resolution 0.1 --quiet --output " + path("new.msh") + " --msh-version 2.2" +
+                             " --output " + path("old.msh") + " --output " + path("mesh.vtu") + " --output " +
+                             path("mesh.mesh"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_EQ(file_text(path("new.msh")).rfind("$MeshFormat\n4.1 0 8\n", 0), 0u);
+  EXPECT_EQ(file_text(path("old.msh")).rfind("$MeshFormat\n2.2 0 8\n", 0), 0u);
+  const auto sizes = group_sizes(path("new.msh"));
+  EXPECT_EQ(group_sizes(path("old.msh")), sizes);
+  for (const char* name : {"interface_bottom", "interface_top"})
+    ASSERT_GT(sizes.count(name) ? sizes.at(name) : 0u, 0u) << name;
+
+  const testing::VtuFile vtu = testing::read_vtu(path("mesh.vtu"));
+  std::map<int, std::size_t> cells_of_tag;
+  for (const double tag : vtu.arrays.at("group")) ++cells_of_tag[static_cast<int>(tag)];
+  ASSERT_EQ(vtu.field.size(), sizes.size());
+  for (const auto& [name, tag] : vtu.field)
+    EXPECT_EQ(cells_of_tag[static_cast<int>(tag.at(0))], sizes.at(name)) << name;
+
+  // Box sides are references 1..6, the interfaces 7 and 8, in the order of the surfaces.
+  const std::string medit = file_text(path("mesh.mesh"));
+  EXPECT_NE(medit.find("\n# Triangles ref 7 interface_bottom\n"), std::string::npos) << medit.substr(0, 400);
+  EXPECT_NE(medit.find("\n# Triangles ref 8 interface_top\n"), std::string::npos) << medit.substr(0, 400);
+  const auto triangles = medit_triangles_per_reference(path("mesh.mesh"));
+  EXPECT_EQ(triangles.at(7), sizes.at("interface_bottom"));
+  EXPECT_EQ(triangles.at(8), sizes.at("interface_top"));
+  EXPECT_EQ(triangles.at(1), sizes.at("xmin"));
+}
+
+TEST_F(CliTest, AFailedWriteRemovesTheFilesTheRunWrote) {
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --level 1 --output " + path("a.msh") + " --output " + path("a.vtu") +
+                             " --output /nonexistent-dir/out.mesh");
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_NE(run.output.find("cannot write /nonexistent-dir/out.mesh"), std::string::npos) << run.output;
+  EXPECT_TRUE(only_inputs_in_directory(0));
 }
 
 TEST_F(CliTest, UnwritableOutputFailsWithStatusOne) {

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -27,7 +28,7 @@
 
 namespace {
 
-constexpr const char* usage_text = R"(Usage: meccano-immerse --box X0,Y0,Z0,X1,Y1,Z1 [options] --output FILE.msh
+constexpr const char* usage_text = R"(Usage: meccano-immerse --box X0,Y0,Z0,X1,Y1,Z1 [options] --output FILE
 
 Builds the meccano tetrahedral mesh of a box (equal cells as close to cubes as possible, 6 Kuhn tets
 per cell, refined uniformly by Kossaczky bisection) and inserts immersed surfaces into it.
@@ -62,15 +63,24 @@ Options:
                            equilateral min, mean, std; min_dihedral_deg; seconds per stage and total)
   --histograms FILE.csv    quality histograms before and after smoothing, both measures (plot them
                            with scripts/plot_quality.py)
-  --output FILE.msh        Gmsh MSH 4.1 ASCII with the 3D group `domain`, the 2D groups xmin, xmax,
-                           ymin, ymax, zmin, zmax, and the groups of the stage (may repeat)
+  --output FILE            the mesh with the 3D group `domain`, the 2D groups xmin, xmax, ymin, ymax,
+                           zmin, zmax, and the groups of the stage (may repeat), in the format of the
+                           file's extension:
+                           .msh   Gmsh MSH 4.1 ASCII (or 2.2, see --msh-version)
+                           .vtu   VTK XML for ParaView: cell data `group` (tags named in the field
+                                  data), quality_meccano and quality_equilateral
+                           .mesh  Medit, references named in comment lines (# Triangles ref 7 ...)
+  --msh-version V          4.1 (default) or 2.2 for older readers; applies to the .msh outputs that
+                           follow it
   --quiet                  no progress output
   --help                   this text
 
 Examples:
   meccano-immerse --box 0,0,0,1,1,1 --level 9 --output cube.msh
   meccano-immerse --box 0,0,0,2,1,1 --level 6 --output bar.msh      (two unit cells)
-  meccano-immerse --box 0,0,0,1,1,1 --surface patch.obj:fault --resolution 0.03 --output fault.msh
+  meccano-immerse --box 0,0,0,1,1,1 --surface patch.obj:fault --resolution 0.03 --output fault.msh \
+                  --output fault.vtu                                (and a ParaView file)
+  meccano-immerse --box 0,0,0,1,1,1 --level 6 --msh-version 2.2 --output cube22.msh --output cube.mesh
   meccano-immerse --box 0,0,0,1,1,1 --surface patch.obj:fault --resolution 0.03 \
                   --stage volumetric --output fault_vm.msh
 )";
@@ -91,12 +101,17 @@ std::optional<meccano::Stage> stage_named(const std::string& name) {
   return std::nullopt;
 }
 
+struct Output {
+  std::string path;
+  meccano::MeshWriteOptions format;
+};
+
 struct Options {
   meccano::Box box;
   bool box_given = false;
   std::optional<std::array<int, 3>> cells;
   int level = 0;
-  std::vector<std::string> outputs;
+  std::vector<Output> outputs;
   std::vector<std::pair<std::string, std::string>> surfaces;  // file, name
   std::optional<double> resolution;
   std::optional<std::string> stage;
@@ -156,6 +171,8 @@ int parse_int(const std::string& option, const std::string& text) {
 
 Options parse_options(int argc, char** argv) {
   Options options;
+  meccano::MeshWriteOptions output_format;  // for the outputs that follow
+  bool msh_version_unused = false;
   std::vector<std::string> args(argv + 1, argv + argc);
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
@@ -216,7 +233,19 @@ Options parse_options(int argc, char** argv) {
     } else if (arg == "--histograms") {
       options.histograms = value();
     } else if (arg == "--output" || arg == "-o") {
-      options.outputs.push_back(value());
+      const std::string& path = value();
+      const auto format = meccano::mesh_format_of(path);
+      if (!format)
+        throw UsageError("--output " + path + ": unknown format; the extensions are .msh (Gmsh), .vtu (ParaView) and "
+                         ".mesh (Medit)");
+      if (*format == meccano::MeshFormat::msh) msh_version_unused = false;
+      options.outputs.push_back({path, output_format});
+    } else if (arg == "--msh-version") {
+      const std::string& version = value();
+      if (version != "4.1" && version != "2.2")
+        throw UsageError("--msh-version " + version + ": the versions are 4.1 and 2.2");
+      output_format.msh_version = version == "2.2" ? meccano::MshVersion::v22 : meccano::MshVersion::v41;
+      msh_version_unused = true;
     } else if (arg == "--quiet" || arg == "-q") {
       options.quiet = true;
     } else {
@@ -225,6 +254,7 @@ Options parse_options(int argc, char** argv) {
   }
   if (!options.box_given) throw UsageError("--box is required");
   if (options.outputs.empty()) throw UsageError("--output is required");
+  if (msh_version_unused) throw UsageError("--msh-version applies to the .msh outputs after it, and none follows");
   if (!options.surfaces.empty() && !options.resolution) throw UsageError("--surface needs --resolution");
   if (options.surfaces.empty() && (options.resolution || options.stage || options.histograms))
     throw UsageError("--resolution, --stage and --histograms need at least one --surface");
@@ -234,9 +264,6 @@ Options parse_options(int argc, char** argv) {
     for (std::size_t j = 0; j < i; ++j)
       if (options.surfaces[i].second == options.surfaces[j].second)
         throw UsageError("two surfaces are named " + options.surfaces[i].second);
-  for (const auto& output : options.outputs)
-    if (output.size() < 4 || output.substr(output.size() - 4) != ".msh")
-      throw UsageError("--output " + output + ": only .msh output is supported");
   return options;
 }
 
@@ -291,21 +318,36 @@ int run(const Options& options) {
   const auto check = meccano::verify_mesh(result.mesh, {.physical = insertion.last_stage != meccano::Stage::projection});
   if (!check.ok()) throw meccano::MeshingError("the mesh fails its invariant checks: " + check.summary());
 
-  const auto groups = meccano::output_groups(result);
-  for (const auto& output : options.outputs) {
-    meccano::write_msh41(result.mesh, groups, output);
-    progress.say("wrote ", output, ": ", result.mesh.num_tets(), " tets, ", result.mesh.num_vertices(), " nodes");
-  }
-  if (options.histograms) {
-    const std::pair<std::string, const meccano::QualitySummary*> labelled[] = {
-        {"before_smoothing", &result.quality_before_smoothing}, {"after_smoothing", &result.quality_after_smoothing}};
-    meccano::write_quality_histograms_csv(*options.histograms, labelled);
-    progress.say("wrote ", *options.histograms);
-  }
-  if (options.report) {
-    const std::string report = meccano::insertion_report_json(result, insertion.last_stage);
-    meccano::write_file_atomically(*options.report, [&report](std::ostream& out) { out << report; });
-    progress.say("wrote ", *options.report);
+  // Each file is written atomically; should a later one fail, the earlier ones are removed, so that a
+  // failed run leaves no file.
+  std::vector<std::string> written;
+  try {
+    const auto groups = meccano::output_groups(result, insertion.last_stage);
+    for (const auto& output : options.outputs) {
+      meccano::write_mesh(result.mesh, groups, output.path, output.format);
+      written.push_back(output.path);
+      progress.say("wrote ", output.path, ": ", result.mesh.num_tets(), " tets, ", result.mesh.num_vertices(),
+                   " nodes");
+    }
+    if (options.histograms) {
+      const std::pair<std::string, const meccano::QualitySummary*> labelled[] = {
+          {"before_smoothing", &result.quality_before_smoothing}, {"after_smoothing", &result.quality_after_smoothing}};
+      meccano::write_quality_histograms_csv(*options.histograms, labelled);
+      written.push_back(*options.histograms);
+      progress.say("wrote ", *options.histograms);
+    }
+    if (options.report) {
+      const std::string report = meccano::insertion_report_json(result, insertion.last_stage);
+      meccano::write_file_atomically(*options.report, [&report](std::ostream& out) { out << report; });
+      written.push_back(*options.report);
+      progress.say("wrote ", *options.report);
+    }
+  } catch (...) {
+    for (const auto& file : written) {
+      std::error_code ignored;
+      std::filesystem::remove(file, ignored);
+    }
+    throw;
   }
   return 0;
 }

@@ -1,96 +1,58 @@
 #include <meccano/mesh_io.hpp>
 
-#include <meccano/atomic_file.hpp>
+#include "mesh_io_helpers.hpp"
+
 #include <meccano/error.hpp>
 
-#include <algorithm>
-#include <charconv>
+#include <array>
 #include <map>
-#include <ostream>
+#include <stdexcept>
+#include <string_view>
+#include <utility>
 
 namespace meccano {
-namespace {
+namespace mesh_io {
 
-// Fast text output of numbers: meshes of millions of tets are written as ASCII.
-class TextWriter {
- public:
-  explicit TextWriter(std::ostream& out) : out_(out) {}
-  ~TextWriter() { flush(); }
-  TextWriter& operator<<(std::int64_t value) { return put_number(value); }
-  TextWriter& operator<<(int value) { return put_number(value); }
-  TextWriter& operator<<(double value) { return put_number(value); }
-  TextWriter& operator<<(char c) {
-    reserve(1);
-    buffer_[size_++] = c;
-    return *this;
+void check_groups(const TetMesh& mesh, const MeshGroups& groups) {
+  auto check_name = [](const std::string& name) {
+    if (name.empty()) throw std::invalid_argument("mesh groups: a group has an empty name");
+    for (const char c : name)
+      if (c == '"' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+        throw std::invalid_argument("mesh group '" + name + "': names may not hold '\"' or control characters");
+  };
+  auto check_tet = [&](const std::string& name, TetId t) {
+    if (t < 0 || t >= mesh.num_tets())
+      throw std::invalid_argument("mesh group " + name + ": tet " + std::to_string(t) + " does not exist (" +
+                                  std::to_string(mesh.num_tets()) + " tets)");
+  };
+  for (const TetGroup& group : groups.volumes) {
+    check_name(group.name);
+    for (const TetId t : group.tets) check_tet(group.name, t);
   }
-  TextWriter& operator<<(std::string_view text) {
-    flush();
-    out_ << text;
-    return *this;
-  }
-  void flush() {
-    out_.write(buffer_.data(), static_cast<std::streamsize>(size_));
-    size_ = 0;
-  }
-
- private:
-  template <class T>
-  TextWriter& put_number(T value) {
-    reserve(32);
-    const auto result = std::to_chars(buffer_.data() + size_, buffer_.data() + buffer_.size(), value);
-    size_ = static_cast<std::size_t>(result.ptr - buffer_.data());
-    return *this;
-  }
-  void reserve(std::size_t n) {
-    if (size_ + n > buffer_.size()) flush();
-  }
-  std::ostream& out_;
-  std::array<char, 1 << 16> buffer_{};
-  std::size_t size_ = 0;
-};
-
-// Partition of items (tets, or faces keyed tet·4 + f) into entities by the set of groups each belongs
-// to; an entity holds the items of one membership set, in increasing key order.
-struct Partition {
-  std::vector<std::vector<int>> entity_groups;
-  std::vector<std::vector<std::int64_t>> entity_items;
-};
-
-Partition partition_by_membership(std::int64_t key_count, const std::vector<std::vector<std::int64_t>>& group_keys) {
-  if (group_keys.size() > 64) throw InputError("more than 64 groups of one dimension cannot be written");
-  std::vector<std::uint64_t> membership(static_cast<std::size_t>(key_count), 0);
-  for (std::size_t g = 0; g < group_keys.size(); ++g)
-    for (std::int64_t key : group_keys[g]) membership[key] |= std::uint64_t{1} << g;
-  Partition partition;
-  std::map<std::uint64_t, std::size_t> entity_of_mask;
-  for (std::int64_t key = 0; key < key_count; ++key) {
-    const std::uint64_t mask = membership[key];
-    if (mask == 0) continue;
-    auto [it, inserted] = entity_of_mask.try_emplace(mask, partition.entity_groups.size());
-    if (inserted) {
-      std::vector<int> groups;
-      for (int g = 0; g < 64; ++g)
-        if (mask >> g & 1) groups.push_back(g);
-      partition.entity_groups.push_back(std::move(groups));
-      partition.entity_items.emplace_back();
+  for (const FaceGroup& group : groups.surfaces) {
+    check_name(group.name);
+    for (const FaceRef& face : group.faces) {
+      check_tet(group.name, face.tet);
+      if (face.local_face < 0 || face.local_face > 3)
+        throw std::invalid_argument("mesh group " + group.name + ": tet " + std::to_string(face.tet) +
+                                    " has no local face " + std::to_string(face.local_face));
     }
-    partition.entity_items[it->second].push_back(key);
   }
-  // Entities in the order of their groups, so that files are stable and easy to read.
-  std::vector<std::size_t> order(partition.entity_groups.size());
-  for (std::size_t e = 0; e < order.size(); ++e) order[e] = e;
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return partition.entity_groups[a] < partition.entity_groups[b]; });
-  Partition sorted;
-  for (std::size_t e : order) {
-    sorted.entity_groups.push_back(std::move(partition.entity_groups[e]));
-    sorted.entity_items.push_back(std::move(partition.entity_items[e]));
-  }
-  return sorted;
 }
 
-}  // namespace
+std::int64_t group_tet_count(const MeshGroups& groups) {
+  std::int64_t count = 0;
+  for (const TetGroup& group : groups.volumes) count += static_cast<std::int64_t>(group.tets.size());
+  return count;
+}
+
+std::int64_t group_triangle_count(const MeshGroups& groups) {
+  std::int64_t count = 0;
+  for (const FaceGroup& group : groups.surfaces) count += static_cast<std::int64_t>(group.faces.size());
+  return count;
+}
+
+}  // namespace mesh_io
 
 MeshGroups standard_groups(const TetMesh& mesh, const std::vector<std::string>& interface_names) {
   MeshGroups groups;
@@ -123,81 +85,38 @@ MeshGroups standard_groups(const TetMesh& mesh, const std::vector<std::string>& 
   return groups;
 }
 
-void write_msh41(const TetMesh& mesh, const MeshGroups& groups, const std::string& path) {
-  std::vector<std::vector<std::int64_t>> tet_keys, face_keys;
-  for (const auto& g : groups.volumes) tet_keys.emplace_back(g.tets.begin(), g.tets.end());
-  for (const auto& g : groups.surfaces) {
-    auto& keys = face_keys.emplace_back();
-    for (const FaceRef& f : g.faces) keys.push_back(std::int64_t{f.tet} * 4 + f.local_face);
+namespace {
+
+constexpr std::array<std::pair<std::string_view, MeshFormat>, 3> format_extensions{
+    {{".msh", MeshFormat::msh}, {".vtu", MeshFormat::vtu}, {".mesh", MeshFormat::medit}}};
+
+}  // namespace
+
+std::optional<MeshFormat> mesh_format_of(const std::string& path) {
+  for (const auto& [extension, format] : format_extensions)
+    if (path.size() > extension.size() && path.ends_with(extension)) return format;
+  return std::nullopt;
+}
+
+void write_mesh(const TetMesh& mesh, const MeshGroups& groups, const std::string& path,
+                const MeshWriteOptions& options) {
+  const std::optional<MeshFormat> format = mesh_format_of(path);
+  if (!format)
+    throw InputError("cannot write " + path + ": unknown mesh format (the extensions are .msh, .vtu and .mesh)");
+  switch (*format) {
+    case MeshFormat::msh:
+      if (options.msh_version == MshVersion::v22)
+        write_msh22(mesh, groups, path);
+      else
+        write_msh41(mesh, groups, path);
+      return;
+    case MeshFormat::vtu:
+      write_vtu(mesh, groups, path);
+      return;
+    case MeshFormat::medit:
+      write_medit(mesh, groups, path);
+      return;
   }
-  const Partition volumes = partition_by_membership(mesh.num_tets(), tet_keys);
-  const Partition surfaces = partition_by_membership(std::int64_t{4} * mesh.num_tets(), face_keys);
-
-  write_file_atomically(path, [&](std::ostream& stream) {
-    TextWriter out(stream);
-    out << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
-    out << "$PhysicalNames\n" << static_cast<int>(groups.volumes.size() + groups.surfaces.size()) << '\n';
-    for (std::size_t g = 0; g < groups.volumes.size(); ++g)
-      out << "3 " << static_cast<int>(g + 1) << " \"" << std::string_view(groups.volumes[g].name) << "\"\n";
-    for (std::size_t g = 0; g < groups.surfaces.size(); ++g)
-      out << "2 " << static_cast<int>(g + 1) << " \"" << std::string_view(groups.surfaces[g].name) << "\"\n";
-    out << "$EndPhysicalNames\n";
-
-    const Box& box = mesh.meccano.box;
-    auto bounding_box = [&] {
-      out << box.min.x() << ' ' << box.min.y() << ' ' << box.min.z() << ' ' << box.max.x() << ' '
-          << box.max.y() << ' ' << box.max.z();
-    };
-    auto physical_tags = [&](const std::vector<int>& member_of) {
-      out << ' ' << static_cast<int>(member_of.size());
-      for (int g : member_of) out << ' ' << g + 1;
-    };
-    out << "$Entities\n0 0 " << static_cast<int>(surfaces.entity_groups.size()) << ' '
-        << static_cast<int>(volumes.entity_groups.size()) << '\n';
-    for (std::size_t e = 0; e < surfaces.entity_groups.size(); ++e) {
-      out << static_cast<int>(e + 1) << ' ';
-      bounding_box();
-      physical_tags(surfaces.entity_groups[e]);
-      out << " 0\n";
-    }
-    for (std::size_t e = 0; e < volumes.entity_groups.size(); ++e) {
-      out << static_cast<int>(e + 1) << ' ';
-      bounding_box();
-      physical_tags(volumes.entity_groups[e]);
-      out << " 0\n";
-    }
-    out << "$EndEntities\n";
-
-    // All nodes in one block of the first volume entity; MSH 4.1 allows elements of any entity to use them.
-    const std::int64_t nodes = mesh.num_vertices();
-    out << "$Nodes\n1 " << nodes << " 1 " << nodes << "\n3 1 0 " << nodes << '\n';
-    for (std::int64_t v = 1; v <= nodes; ++v) out << v << '\n';
-    for (const auto& p : mesh.points) out << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-    out << "$EndNodes\n";
-
-    std::int64_t element_count = 0;
-    for (const auto& items : surfaces.entity_items) element_count += static_cast<std::int64_t>(items.size());
-    for (const auto& items : volumes.entity_items) element_count += static_cast<std::int64_t>(items.size());
-    out << "$Elements\n"
-        << static_cast<int>(surfaces.entity_items.size() + volumes.entity_items.size()) << ' ' << element_count
-        << " 1 " << element_count << '\n';
-    std::int64_t tag = 0;
-    for (std::size_t e = 0; e < surfaces.entity_items.size(); ++e) {
-      out << "2 " << static_cast<int>(e + 1) << " 2 " << static_cast<std::int64_t>(surfaces.entity_items[e].size()) << '\n';
-      for (std::int64_t key : surfaces.entity_items[e]) {
-        const auto face = mesh.outward_face(static_cast<TetId>(key / 4), static_cast<int>(key % 4));
-        out << ++tag << ' ' << face[0] + 1 << ' ' << face[1] + 1 << ' ' << face[2] + 1 << '\n';
-      }
-    }
-    for (std::size_t e = 0; e < volumes.entity_items.size(); ++e) {
-      out << "3 " << static_cast<int>(e + 1) << " 4 " << static_cast<std::int64_t>(volumes.entity_items[e].size()) << '\n';
-      for (std::int64_t t : volumes.entity_items[e]) {
-        const auto v = mesh.oriented_tet(static_cast<TetId>(t));
-        out << ++tag << ' ' << v[0] + 1 << ' ' << v[1] + 1 << ' ' << v[2] + 1 << ' ' << v[3] + 1 << '\n';
-      }
-    }
-    out << "$EndElements\n";
-  });
 }
 
 }  // namespace meccano

@@ -208,7 +208,7 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
   return result;
 }
 
-MeshGroups output_groups(const InsertionResult& result) {
+MeshGroups output_groups(const InsertionResult& result, Stage last_stage) {
   MeshGroups groups;
   const MeshGroups standard = standard_groups(result.mesh);
   groups.volumes = standard.volumes;
@@ -216,10 +216,12 @@ MeshGroups output_groups(const InsertionResult& result) {
     if (group.name.rfind("interface_", 0) != 0) groups.surfaces.push_back(group);  // box sides
   for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s) {
     const SurfaceInsertion& inserted = result.surfaces[s];
-    TetGroup volume{"volumetric_" + inserted.name, {}};
-    for (TetId t = 0; t < result.mesh.num_tets(); ++t)
-      if (inserted.volumetric[t]) volume.tets.push_back(t);
-    groups.volumes.push_back(std::move(volume));
+    if (last_stage != Stage::smoothing) {
+      TetGroup volume{"volumetric_" + inserted.name, {}};
+      for (TetId t = 0; t < result.mesh.num_tets(); ++t)
+        if (inserted.volumetric[t]) volume.tets.push_back(t);
+      groups.volumes.push_back(std::move(volume));
+    }
     if (inserted.healing_stats.side != 0)
       groups.surfaces.push_back(
           {"interface_" + inserted.name,

@@ -1,17 +1,42 @@
-// Mesh output with named groups, in the formats solvers read.
+// Mesh output with named groups, in the formats solvers and viewers read.
 //
-// Groups: named sets of tets (3D physical groups) and of faces (2D physical groups). A face is given by
-// a tet and its local face and is written with its normal pointing out of that tet, so the caller
-// fixes each group's orientation. standard_groups() gives what every output carries: `domain` (all
-// tets), the box sides `xmin` ... `zmax` (outward normals), and one group per interface tag.
-// MSH 4.1 ASCII: groups may overlap (a tet in `domain` and in `volumetric_1`); elements are written
-// once, in entities that partition them by group membership, and every physical group is the union of
-// its entities.
-// Writes are atomic (atomic_file.hpp).
+// Groups: named sets of tets (3D groups) and of faces (2D groups). A face is given by a tet and its local
+// face and is written with its normal pointing out of that tet, so the caller fixes each group's
+// orientation; tets are written positively oriented. standard_groups() gives what every output carries:
+// `domain` (all tets), the box sides `xmin` ... `zmax` (outward normals), and one group per interface
+// tag. Group names may not be empty nor hold '"' or control characters; every tet and face of a group
+// must exist (std::invalid_argument otherwise). Only elements of some group are written; every vertex is.
+//
+// The formats (write_mesh picks one from the file's extension):
+//   .msh   Gmsh MSH 4.1 ASCII (write_msh41, the default): groups may overlap (a tet in `domain` and in
+//          `volumetric_1`); elements are written once, in entities that partition them by group
+//          membership, and every physical group is the union of its entities.
+//          Gmsh MSH 2.2 ASCII (write_msh22, for older readers): physical tags 1, 2, ... per dimension in
+//          group order; an element in several groups is written once per group (Gmsh's convention),
+//          each group in an elementary entity of its own (tag = physical tag), so that a reader counts
+//          every group's elements exactly.
+//   .vtu   VTK XML UnstructuredGrid (write_vtu, for ParaView), little-endian, base64 binary arrays with
+//          UInt64 headers (millions of tets): points Float64 x 3; cells are the tets of every 3D group
+//          (VTK_TETRA), group by group, then the faces of every 2D group (VTK_TRIANGLE), an element once
+//          per group like MSH 2.2; connectivity Int32, offsets Int64. Cell data:
+//            group                Int32, the group's tag: 3D groups 1..n3 in order, then 2D groups
+//                                 n3 + 1 ... (threshold on it to see one interface or box side);
+//            quality_meccano      Float64, mean ratio of the tet against its computational (meccano)
+//                                 counterpart (quality.hpp), negative for an inverted tet;
+//            quality_equilateral  Float64, mean ratio against the equilateral tet;
+//            both are 1 on triangles, a neutral value that never shows up among bad elements.
+//          Field data: one Int32 array per group, named like the group, holding its tag.
+//   .mesh  Medit ASCII (write_medit, MeshVersionFormatted 2): a tet once, with reference = 1-based index
+//          of its first 3D group (`domain` = 1); a face once per 2D group, with reference = 1-based index
+//          of that group (standard groups: box sides 1..6 in the order xmin..zmax, then the interfaces).
+//          Comment lines after the header name the references: `# Tetrahedra ref 1 domain`,
+//          `# Triangles ref 7 interface_patch`.
+// Writes are atomic (atomic_file.hpp): a failed write leaves no file; InputError names the path.
 #pragma once
 
 #include <meccano/tet_mesh.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,5 +69,23 @@ struct MeshGroups {
 MeshGroups standard_groups(const TetMesh& mesh, const std::vector<std::string>& interface_names = {});
 
 void write_msh41(const TetMesh& mesh, const MeshGroups& groups, const std::string& path);
+void write_msh22(const TetMesh& mesh, const MeshGroups& groups, const std::string& path);
+void write_vtu(const TetMesh& mesh, const MeshGroups& groups, const std::string& path);
+void write_medit(const TetMesh& mesh, const MeshGroups& groups, const std::string& path);
+
+enum class MeshFormat { msh, vtu, medit };
+enum class MshVersion { v41, v22 };
+
+struct MeshWriteOptions {
+  MshVersion msh_version = MshVersion::v41;  // for .msh files
+};
+
+// The format of a file name's extension (.msh, .vtu, .mesh), or nothing for any other name.
+std::optional<MeshFormat> mesh_format_of(const std::string& path);
+
+// Writes with the writer of the path's extension. Throws InputError naming the path if the extension is
+// not one of .msh, .vtu, .mesh (nothing is written then).
+void write_mesh(const TetMesh& mesh, const MeshGroups& groups, const std::string& path,
+                const MeshWriteOptions& options = {});
 
 }  // namespace meccano

@@ -76,9 +76,11 @@ std::string insertion_report_json(const InsertionResult& result, Stage last_stag
 
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options);
 
-// `domain`, the box sides, `volumetric_NAME` for every surface's V_M, and `interface_NAME` for every
-// surface's S_M (once built), oriented like the surface.
-MeshGroups output_groups(const InsertionResult& result);
+// `domain`, the box sides, and `interface_NAME` for every surface's S_M (once built), oriented like the
+// surface; at the inspection stages (last_stage before smoothing) also `volumetric_NAME` for every
+// surface's V_M. The final mesh leaves V_M out: formats that write an element once per group (MSH 2.2,
+// VTU) would otherwise hold its tets twice.
+MeshGroups output_groups(const InsertionResult& result, Stage last_stage = Stage::smoothing);
 
 // What a solver needs to impose a condition on an inserted surface: each face of S_M once, with the
 // tets on both sides. The vertex order and `normal` agree with the surface's normals (right-hand rule);

@@ -132,6 +132,8 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
        "the modes are whole and band"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --target cube --output " + path("a.msh"),
        "the targets are meccano and equilateral"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --side up --output " + path("a.msh"),
+       "the rules are positive, negative, positive-only and negative-only"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --threads 0 --output " + path("a.msh"),
        "--threads must be at least 1"},
       {"--box 0,0,0,1,1,1 --histograms h.csv --output " + path("a.msh"), "need at least one --surface"},
@@ -189,6 +191,16 @@ TEST_F(CliTest, ApproximationStageWritesOneInterfaceGroupPerSurface) {
   const auto sizes = group_sizes(path("sm.msh"));
   for (const char* name : {"interface_bottom", "interface_top", "volumetric_bottom", "volumetric_top", "domain"})
     EXPECT_GT(sizes.count(name) ? sizes.at(name) : 0u, 0u) << name;
+}
+
+TEST_F(CliTest, TheSideRuleChoosesWhereSMIsBuilt) {
+  const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
+  for (const auto& [rule, side] : {std::pair{"negative-only", "side -"}, std::pair{"positive", "side +"}}) {
+    const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + surface + ":patch --resolution 0.1 --side " + rule +
+                               " --stage approximation --output " + path("sm.msh"));
+    ASSERT_EQ(run.status, 0) << run.output;
+    EXPECT_NE(run.output.find(std::string("approximation patch: ") + side), std::string::npos) << rule << run.output;
+  }
 }
 
 TEST_F(CliTest, ProjectionStageWritesTheInterfaceOnTheSurface) {

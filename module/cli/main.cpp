@@ -50,6 +50,10 @@ Options:
                            projection     S_M's nodes moved onto the surfaces; tets may be inverted
                                           (this output only)
                            smoothing      untangled and smoothed: the result
+  --side RULE              the side of each surface S_M is built on (S's normals point to the
+                           positive side): positive (default) or negative first, the other side if
+                           healing or untangling fails there; positive-only or negative-only never
+                           switch
   --smoothing MODE         whole (default: every node may move, as in the paper) or band (only nodes
                            within --band-rings edge rings of the surfaces)
   --band-rings N           rings of the band (default 3)
@@ -101,6 +105,14 @@ std::optional<meccano::Stage> stage_named(const std::string& name) {
   return std::nullopt;
 }
 
+std::optional<meccano::SideRule> side_rule_named(const std::string& name) {
+  if (name == "positive") return meccano::SideRule::positive_first;
+  if (name == "negative") return meccano::SideRule::negative_first;
+  if (name == "positive-only") return meccano::SideRule::positive_only;
+  if (name == "negative-only") return meccano::SideRule::negative_only;
+  return std::nullopt;
+}
+
 struct Output {
   std::string path;
   meccano::MeshWriteOptions format;
@@ -115,6 +127,7 @@ struct Options {
   std::vector<std::pair<std::string, std::string>> surfaces;  // file, name
   std::optional<double> resolution;
   std::optional<std::string> stage;
+  meccano::SideRule side_rule = meccano::SideRule::positive_first;
   meccano::SmoothingOptions smoothing;
   std::optional<int> threads;
   std::optional<std::string> report;
@@ -209,6 +222,12 @@ Options parse_options(int argc, char** argv) {
       if (!stage_named(*options.stage))
         throw UsageError("--stage " + *options.stage +
                          ": the stages available are: volumetric, approximation, projection, smoothing");
+    } else if (arg == "--side") {
+      const std::string& rule = value();
+      const auto named = side_rule_named(rule);
+      if (!named)
+        throw UsageError("--side " + rule + ": the rules are positive, negative, positive-only and negative-only");
+      options.side_rule = *named;
     } else if (arg == "--smoothing") {
       const std::string& mode = value();
       if (mode != "whole" && mode != "band") throw UsageError("--smoothing " + mode + ": the modes are whole and band");
@@ -310,6 +329,7 @@ int run(const Options& options) {
   meccano::InsertionOptions insertion;
   insertion.resolution = options.resolution.value_or(0.0);
   insertion.last_stage = options.stage ? *stage_named(*options.stage) : meccano::Stage::smoothing;
+  insertion.approximation.side_rule = options.side_rule;
   insertion.smoothing = options.smoothing;
   insertion.progress = [&progress](const std::string& line) { progress.say(line); };
   const meccano::InsertionResult result = meccano::insert_surfaces(std::move(mesh), surfaces, insertion);

@@ -1,7 +1,14 @@
 #!/usr/bin/env bash
-# Set up the machine, build, and run the whole test suite with CTest.
+# Set up the machine, build, and run the whole test suite with CTest; then a short fuzzing run of
+# the surface readers and the validation (20 s per target) when clang and libFuzzer are available.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 scripts/build.sh
 ctest --test-dir build -j"$(nproc)" --output-on-failure
+if command -v clang++ > /dev/null && echo 'extern "C" int LLVMFuzzerTestOneInput(const char*, unsigned long) { return 0; }' \
+     | clang++ -x c++ -fsanitize=fuzzer -o /dev/null - 2> /dev/null; then
+  tests/fuzz/run_fuzz.sh 20
+else
+  echo "fuzz: skipped (clang++ with libFuzzer not available)"
+fi

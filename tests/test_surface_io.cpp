@@ -381,6 +381,25 @@ TEST(SurfaceWeld, MergesPointsWithinToleranceAndRenumbers) {
   EXPECT_EQ(meccano::weld_vertices(surface, 0.0), 0);
 }
 
+// Found by fuzz_read_msh: cell coordinates of points near the largest doubles overflowed (undefined
+// behaviour, and a search over 2^64 cells).
+TEST(SurfaceWeld, PointsNearTheLargestDoublesWeldWithoutOverflow) {
+  TriangleSurface surface;
+  surface.points = {{1.7e308, 0, 0}, {1.0e308, 0, 0}, {1.5e308, 1e308, 0}, {1.7e308, 1e300, 0}};
+  surface.triangles = {{0, 1, 2}, {3, 1, 2}};
+  EXPECT_EQ(meccano::weld_vertices(surface, 1e307), 1);  // the query box of point 0 reaches infinity
+  EXPECT_EQ(surface.triangles[1][0], 0);
+  EXPECT_THROW(meccano::weld_vertices(surface, std::numeric_limits<double>::infinity()), std::invalid_argument);
+}
+
+TEST_F(SurfaceIo, CoordinatesWhoseExtentOverflowsAreRejected) {
+  EXPECT_THAT(read_error("far.off", "OFF\n3 1 0\n-1e308 0 0\n1e308 0 0\n0 1 0\n3 0 1 2\n"),
+              HasSubstr("far.off: coordinates too far apart: the extent of the surface overflows a double"));
+  // Unused vertices do not count for the tolerance, but they are welded too.
+  EXPECT_THAT(read_error("far.obj", "v -1e308 0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1e308 0 0\nf 2 3 4\n"),
+              HasSubstr("far.obj: coordinates too far apart to weld: the extent of the points overflows a double"));
+}
+
 TEST_F(SurfaceIo, WeldsAHundredThousandTriangleBinaryStl) {
   const TriangleSurface grid = grid_patch(224);  // 100352 triangles, 301056 corners in the file
   const TriangleSurface read = meccano::read_stl(write("big.stl", stl_binary_bytes(grid, "big")));

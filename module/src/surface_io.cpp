@@ -236,7 +236,7 @@ double used_bounding_box_diagonal(const TriangleSurface& surface) {
       lo = lo.cwiseMin(surface.points[static_cast<std::size_t>(vertex)]);
       hi = hi.cwiseMax(surface.points[static_cast<std::size_t>(vertex)]);
     }
-  return (hi - lo).norm();
+  return (hi - lo).stableNorm();
 }
 
 // Removes the vertices no triangle uses, keeping the others in file order (messages number them).
@@ -265,8 +265,11 @@ TriangleSurface finish_surface(const std::string& path, std::vector<Eigen::Vecto
   surface.source = path;
   surface.points = std::move(points);
   surface.triangles = std::move(triangles);
+  const double diagonal = used_bounding_box_diagonal(surface);
+  if (!std::isfinite(diagonal))
+    fail_file(path, "coordinates too far apart: the extent of the surface overflows a double");
   // Welding first leaves fewer vertices to scan (an STL file repeats each about six times).
-  weld_vertices(surface, kWeldRelativeTolerance * used_bounding_box_diagonal(surface));
+  weld_vertices(surface, kWeldRelativeTolerance * diagonal);
   drop_unused_vertices(surface);
   return surface;
 }
@@ -782,7 +785,9 @@ struct CellHash {
 // Points bucketed in a uniform grid, each cell listing its points through a linked list.
 class PointGrid {
  public:
-  PointGrid(const Eigen::Vector3d& origin, double cell_size) : origin_(origin), cell_size_(cell_size) {}
+  // The points lie in [origin, origin + extent] on every axis.
+  PointGrid(const Eigen::Vector3d& origin, double cell_size, double extent)
+      : origin_(origin), cell_size_(cell_size), last_cell_(std::floor(extent / cell_size)) {}
 
   // A stored point within `tolerance` of p, or -1. The point's own cell first: it holds the exact
   // duplicates, which are most of the points of an STL file.
@@ -816,13 +821,16 @@ class PointGrid {
       if ((stored[static_cast<std::size_t>(i)] - p).squaredNorm() <= tolerance * tolerance) return i;
     return -1;
   }
+  // Clamped to one cell beyond the occupied ones: a query box next to the largest doubles can reach
+  // infinity, and would otherwise span an unbounded number of cells.
   Cell cell_of(const Eigen::Vector3d& p) const {
-    const Eigen::Array3d q = ((p - origin_) / cell_size_).array().floor();
+    const Eigen::Array3d q = ((p - origin_) / cell_size_).array().floor().cwiseMax(-1.0).cwiseMin(last_cell_ + 1.0);
     return {static_cast<std::int64_t>(q.x()), static_cast<std::int64_t>(q.y()), static_cast<std::int64_t>(q.z())};
   }
 
   Eigen::Vector3d origin_;
   double cell_size_;
+  double last_cell_;
   std::unordered_map<Cell, int, CellHash> first_;
   std::vector<int> next_;
 };
@@ -830,7 +838,8 @@ class PointGrid {
 }  // namespace
 
 int weld_vertices(TriangleSurface& surface, double tolerance) {
-  if (!(tolerance >= 0.0)) throw std::invalid_argument("weld_vertices: the tolerance must be >= 0");
+  if (!(tolerance >= 0.0) || std::isinf(tolerance))
+    throw std::invalid_argument("weld_vertices: the tolerance must be finite and >= 0");
   std::vector<Eigen::Vector3d>& points = surface.points;
   const std::size_t count = points.size();
   for (std::size_t t = 0; t < surface.triangles.size(); ++t)
@@ -848,11 +857,15 @@ int weld_vertices(TriangleSurface& surface, double tolerance) {
       hi = hi.cwiseMax(p);
     }
   const double extent = lo.x() <= hi.x() ? (hi - lo).maxCoeff() : 0.0;
+  // Cell coordinates come from differences of points, which must not overflow.
+  if (!std::isfinite(extent))
+    throw InputError((surface.source.empty() ? surface.name : surface.source) +
+                     ": coordinates too far apart to weld: the extent of the points overflows a double");
   // Cells 4 tolerances wide: most points then look up a single cell. Never finer than 2^-40 of the
   // extent, so that cell coordinates fit in 64 bits whatever the tolerance.
   double cell_size = std::max(4.0 * tolerance, extent * 0x1p-40);
   if (cell_size == 0.0) cell_size = 1.0;  // a single location and a zero tolerance
-  PointGrid grid(lo.allFinite() ? lo : Eigen::Vector3d::Zero(), cell_size);
+  PointGrid grid(lo.allFinite() ? lo : Eigen::Vector3d::Zero(), cell_size, extent);
 
   std::vector<Eigen::Vector3d> kept;
   std::vector<int> new_index(count);

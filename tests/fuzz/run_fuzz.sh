@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (clang, MECCANO_FUZZ: ASan + UBSan + libFuzzer) and runs each for a
+# number of seconds on its seed corpus; fails on the first crash, hang, leak or oversized allocation.
+#
+# Usage: tests/fuzz/run_fuzz.sh [seconds per target, default 60] [build-dir, default /tmp/build-fuzz]
+#
+# New inputs that libFuzzer finds go to <build-dir>/corpus/<target>/ (the seeds under
+# tests/fuzz/corpus/ stay as they are); a crashing input is saved as <build-dir>/artifacts/<target>-*
+# and can be replayed with: <build-dir>/tests/fuzz/<target> <file>.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+seconds=${1:-60}
+build=${2:-/tmp/build-fuzz}
+jobs=$(( $(nproc) < 2 ? $(nproc) : 2 ))
+targets=(fuzz_read_obj fuzz_read_stl fuzz_read_off fuzz_read_msh fuzz_validate_surface)
+
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DMECCANO_FUZZ=ON \
+      -DMECCANO_BUILD_TESTS=OFF -DMECCANO_BUILD_SOLVER_DEMO=OFF > "$build.log" 2>&1 || { cat "$build.log"; exit 1; }
+cmake --build "$build" -j"$jobs" --target "${targets[@]}" >> "$build.log" 2>&1 || { tail -60 "$build.log"; exit 1; }
+
+export ASAN_OPTIONS=halt_on_error=1:detect_leaks=1
+export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+mkdir -p "$build/artifacts"
+for target in "${targets[@]}"; do
+  # Readers see whole files (a few KiB suffice for every section and count); validation inputs
+  # decode at most three 64-triangle surfaces.
+  max_len=16384
+  [ "$target" = fuzz_validate_surface ] && max_len=4096
+  mkdir -p "$build/corpus/$target"
+  log="$build/$target.log"
+  if ! "$build/tests/fuzz/$target" -max_total_time="$seconds" -max_len="$max_len" -rss_limit_mb=2048 \
+       -timeout=10 -print_final_stats=1 -artifact_prefix="$build/artifacts/$target-" \
+       "$build/corpus/$target" "tests/fuzz/corpus/$target" > "$log" 2>&1; then
+    tail -40 "$log"
+    echo "fuzz: $target FAILED (log $log, input in $build/artifacts/)"
+    exit 1
+  fi
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
+  echo "fuzz: $target ok: $runs executions in ${seconds} s"
+done

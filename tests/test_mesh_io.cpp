@@ -393,5 +393,17 @@ TEST(MeshIo, FailedWriteLeavesNoFile) {
   fs::remove_all(dir);
 }
 
+// Writing is by rename, which would replace a device node: /dev/null must stay a device.
+TEST(MeshIo, RefusesToReplaceAFileThatIsNotRegular) {
+  const TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
+  try {
+    write_msh41(mesh, standard_groups(mesh), "/dev/null");
+    ADD_FAILURE() << "wrote over /dev/null";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("/dev/null: not a regular file"), std::string::npos) << error.what();
+  }
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+}
+
 }  // namespace
 }  // namespace meccano

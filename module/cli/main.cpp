@@ -6,6 +6,7 @@
 #include <meccano/error.hpp>
 #include <meccano/mesh_check.hpp>
 #include <meccano/mesh_io.hpp>
+#include <meccano/msh_check.hpp>
 #include <meccano/pipeline.hpp>
 #include <meccano/surface.hpp>
 #include <meccano/surface_validation.hpp>
@@ -21,6 +22,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <omp.h>
@@ -29,6 +31,7 @@
 namespace {
 
 constexpr const char* usage_text = R"(Usage: meccano-immerse --box X0,Y0,Z0,X1,Y1,Z1 [options] --output FILE
+       meccano-immerse check FILE.msh [--report FILE.json] [--quiet]
 
 Builds the meccano tetrahedral mesh of a box (equal cells as close to cubes as possible, 6 Kuhn tets
 per cell, refined uniformly by Kossaczky bisection) and inserts immersed surfaces into it.
@@ -76,8 +79,17 @@ Options:
                            .mesh  Medit, references named in comment lines (# Triangles ref 7 ...)
   --msh-version V          4.1 (default) or 2.2 for older readers; applies to the .msh outputs that
                            follow it
+  --max-tets N             refuse to run when the estimated tet count exceeds N (default: 16 GiB at
+                           about 280 bytes per tet, 61 million tets): a tiny --resolution fails at once
+                           instead of exhausting memory
   --quiet                  no progress output
   --help                   this text
+
+check FILE.msh checks the invariants of a tet mesh of a box in any Gmsh MSH file (2.2 or 4.1, ASCII or
+binary; this tool's, Gmsh's, ...): conformity, orientation, volume, the box sides xmin ... zmax (if the
+file has those groups) and every interface_* group (interior faces forming a consistently oriented
+disk). It prints one line per check (--quiet: nothing), writes them as JSON with --report, and exits 0
+if every check passes, 1 if one fails or the file cannot be read.
 
 Examples:
   meccano-immerse --box 0,0,0,1,1,1 --level 9 --output cube.msh
@@ -87,6 +99,7 @@ Examples:
   meccano-immerse --box 0,0,0,1,1,1 --level 6 --msh-version 2.2 --output cube22.msh --output cube.mesh
   meccano-immerse --box 0,0,0,1,1,1 --surface patch.obj:fault --resolution 0.03 \
                   --stage volumetric --output fault_vm.msh
+  meccano-immerse check fault.msh --report fault_check.json
 )";
 
 struct UsageError : std::runtime_error {
@@ -130,6 +143,7 @@ struct Options {
   meccano::SideRule side_rule = meccano::SideRule::positive_first;
   meccano::SmoothingOptions smoothing;
   std::optional<int> threads;
+  std::int64_t max_tets = meccano::default_max_tets;
   std::optional<std::string> report;
   std::optional<std::string> histograms;
   bool quiet = false;
@@ -170,16 +184,18 @@ std::vector<double> parse_numbers(const std::string& option, const std::string& 
   return values;
 }
 
-int parse_int(const std::string& option, const std::string& text) {
+template <class Int = int>
+Int parse_int(const std::string& option, const std::string& text) {
   std::size_t used = 0;
-  int value = 0;
+  long long value = 0;
   try {
-    value = std::stoi(text, &used);
+    value = std::stoll(text, &used);
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used == 0 || used != text.size()) throw UsageError(option + ": '" + text + "' is not an integer");
-  return value;
+  if (used == 0 || used != text.size() || !std::in_range<Int>(value))
+    throw UsageError(option + ": '" + text + "' is not an integer");
+  return static_cast<Int>(value);
 }
 
 Options parse_options(int argc, char** argv) {
@@ -247,6 +263,9 @@ Options parse_options(int argc, char** argv) {
     } else if (arg == "--threads") {
       options.threads = parse_int(arg, value());
       if (*options.threads < 1) throw UsageError("--threads must be at least 1");
+    } else if (arg == "--max-tets") {
+      options.max_tets = parse_int<std::int64_t>(arg, value());
+      if (options.max_tets < 1) throw UsageError("--max-tets must be at least 1");
     } else if (arg == "--report") {
       options.report = value();
     } else if (arg == "--histograms") {
@@ -312,6 +331,7 @@ int run(const Options& options) {
   const std::int64_t expected_tets = (std::int64_t{6} * cells[0] * cells[1] * cells[2]) << options.level;
   progress.say("meccano: ", cells[0], "x", cells[1], "x", cells[2], " cells, level ", options.level, ", ",
                expected_tets, " tets");
+  meccano::check_tet_estimate(expected_tets, options.max_tets, "the meccano mesh (--cells, --level)");
   // Read and validate every surface before any meshing: bad input must not cost a meshing run.
   std::vector<meccano::TriangleSurface> surfaces;
   for (const auto& [file, name] : options.surfaces) {
@@ -331,6 +351,7 @@ int run(const Options& options) {
   insertion.last_stage = options.stage ? *stage_named(*options.stage) : meccano::Stage::smoothing;
   insertion.approximation.side_rule = options.side_rule;
   insertion.smoothing = options.smoothing;
+  insertion.max_tets = options.max_tets;
   insertion.progress = [&progress](const std::string& line) { progress.say(line); };
   const meccano::InsertionResult result = meccano::insert_surfaces(std::move(mesh), surfaces, insertion);
 
@@ -372,10 +393,43 @@ int run(const Options& options) {
   return 0;
 }
 
+// meccano-immerse check FILE.msh [--report FILE.json] [--quiet]: 0 if every check passes, 1 otherwise.
+int run_check(const std::vector<std::string>& args) {
+  std::optional<std::string> file, report;
+  bool quiet = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (arg == "--help" || arg == "-h") {
+      std::cout << usage_text;
+      return 0;
+    } else if (arg == "--report") {
+      if (i + 1 >= args.size()) throw UsageError("check: --report needs a value");
+      report = args[++i];
+    } else if (arg == "--quiet" || arg == "-q") {
+      quiet = true;
+    } else if (arg.starts_with('-')) {
+      throw UsageError("check: unknown option '" + arg + "'");
+    } else if (file) {
+      throw UsageError("check takes one mesh file, got '" + *file + "' and '" + arg + "'");
+    } else {
+      file = arg;
+    }
+  }
+  if (!file) throw UsageError("check needs a mesh file: meccano-immerse check FILE.msh");
+  const meccano::MeshFileCheck result = meccano::check_mesh_file(*file);
+  if (!quiet) std::cout << result.text();
+  if (report) {
+    const std::string json = result.json();
+    meccano::write_file_atomically(*report, [&json](std::ostream& out) { out << json; });
+  }
+  return result.passed() ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   try {
+    if (argc > 1 && std::string(argv[1]) == "check") return run_check({argv + 2, argv + argc});
     return run(parse_options(argc, argv));
   } catch (const UsageError& error) {
     std::cerr << "meccano-immerse: " << error.what() << "\n(see meccano-immerse --help)\n";

@@ -16,6 +16,11 @@ namespace meccano {
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
   namespace fs = std::filesystem;
   const fs::path target(path);
+  // Renaming over a device or a FIFO (as root, /dev/full or /dev/null) would replace it: refuse.
+  std::error_code status_error;
+  const fs::file_status status = fs::status(target, status_error);
+  if (fs::exists(status) && !fs::is_regular_file(status))
+    throw InputError("cannot write " + path + ": not a regular file");
   fs::path temporary = target;
   temporary += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(std::random_device{}());
   auto fail = [&](const std::string& reason) {

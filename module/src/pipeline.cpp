@@ -5,6 +5,8 @@
 
 #include <omp.h>
 
+#include <Eigen/Geometry>
+
 #include <chrono>
 #include <sstream>
 
@@ -185,8 +187,38 @@ std::vector<SideRule> other_side_rules(const InsertionResult& result, std::span<
 
 // A surface whose S_M cannot be untangled on one side of S may be on the other: the whole insertion is
 // run again from the input mesh with those surfaces' S_M on their other side, as healing itself does.
+std::int64_t estimate_tets(std::int64_t meccano_tets, std::span<const TriangleSurface> surfaces, double resolution) {
+  constexpr double tets_per_area = 185.0;  // per l_r², see pipeline.hpp
+  double area = 0.0;
+  for (const TriangleSurface& surface : surfaces)
+    for (const auto& [a, b, c] : surface.triangles)
+      area += 0.5 * (surface.points[b] - surface.points[a]).cross(surface.points[c] - surface.points[a]).norm();
+  const double layer = tets_per_area * area / (resolution * resolution);
+  // Saturates instead of overflowing: l_r = 1e-300 is an estimate too.
+  const double total = static_cast<double>(meccano_tets) + layer;
+  return total < 0x1p62 ? static_cast<std::int64_t>(total) : std::int64_t{1} << 62;
+}
+
+void check_tet_estimate(std::int64_t estimated_tets, std::int64_t max_tets, const std::string& what) {
+  if (estimated_tets <= max_tets) return;
+  std::ostringstream message;
+  message.precision(3);
+  message << what << " would make about " << static_cast<double>(estimated_tets) << " tets (about "
+          << static_cast<double>(estimated_tets) * estimated_bytes_per_tet / (1 << 30) << " GiB of memory), above the "
+          << "limit of " << max_tets << " tets; use a coarser setting or raise the limit (--max-tets, "
+          << "InsertionOptions::max_tets)";
+  throw InputError(message.str());
+}
+
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();
+  if (!surfaces.empty()) {
+    if (!(options.resolution > 0.0))
+      throw InputError("the resolution l_r must be positive (got " + std::to_string(options.resolution) + ")");
+    std::ostringstream what;
+    what << "the resolution l_r = " << options.resolution;
+    check_tet_estimate(estimate_tets(mesh.num_tets(), surfaces, options.resolution), options.max_tets, what.str());
+  }
   const ThreadCount threads(options.threads);
   const std::vector<SideRule> rules(surfaces.size(), options.approximation.side_rule);
   InsertionResult result = run_stages(mesh, surfaces, options, rules);

@@ -15,6 +15,8 @@
 //          lists each surface's faces with the tets on both sides, output_groups() the named groups the
 //          file writers take.
 // Progress a callback receives one line per stage with counts.
+// Refusal before any refinement: l_r <= 0 (with surfaces), or an estimated tet count (estimate_tets) above
+//          options.max_tets, are InputErrors: an absurdly small l_r fails at once instead of exhausting memory.
 #pragma once
 
 #include <meccano/mesh_io.hpp>
@@ -27,6 +29,7 @@
 #include <meccano/volumetric_approximation.hpp>
 
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <span>
 #include <string>
@@ -36,12 +39,28 @@ namespace meccano {
 
 enum class Stage { volumetric, approximation, projection, smoothing };
 
+// Memory per tet while the pipeline runs: the mesh's 53-80 bytes (doc/design.md) plus the stages' working
+// arrays, about 200; the default limit keeps a run below 16 GiB.
+inline constexpr std::int64_t estimated_bytes_per_tet = 280;
+inline constexpr std::int64_t default_max_tets = (std::int64_t{16} << 30) / estimated_bytes_per_tet;
+
+// The tet count after step 1, estimated before any refinement: the meccano's tets plus, per surface,
+// the V_M layer, whose tets have their longest edge below l_r and cover the surface a few tets thick:
+// 185 tets per l_r² of surface area, fitted on the cube example's final counts (73 712, 256 636 and
+// 971 248 tets at l_r = 1/32, 1/64, 1/128, which it matches to -0.3 %, +15 % and +21 %).
+std::int64_t estimate_tets(std::int64_t meccano_tets, std::span<const TriangleSurface> surfaces, double resolution);
+
+// Throws InputError if `estimated_tets` exceeds `max_tets`, naming `what` (the cause) and the memory it
+// would take.
+void check_tet_estimate(std::int64_t estimated_tets, std::int64_t max_tets, const std::string& what);
+
 struct InsertionOptions {
   double resolution = 0.0;  // l_r, a length in physical units
   Stage last_stage = Stage::smoothing;
   SurfaceApproximationOptions approximation;  // side rule, healing pass limit
   SmoothingOptions smoothing;                 // SUS mode, target and limits
   int threads = 0;                            // OpenMP threads for this call; 0 = OpenMP's default
+  std::int64_t max_tets = default_max_tets;    // refuse when estimate_tets exceeds it
   std::function<void(const std::string&)> progress;  // one line per stage, with counts
 };
 

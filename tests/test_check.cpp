@@ -8,6 +8,7 @@
 #include <meccano/msh_check.hpp>
 #include <meccano/pipeline.hpp>
 
+#include <run_command.hpp>
 #include <test_surfaces.hpp>
 
 #include <gtest/gtest.h>
@@ -24,7 +25,6 @@
 #include <string>
 #include <vector>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 namespace meccano {
@@ -32,21 +32,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandRun {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
-
-CommandRun run_command(const std::string& command) {
-  CommandRun run;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return run;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) run.output += buffer.data();
-  const int raw = ::pclose(pipe);
-  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return run;
-}
+using testing::CommandRun;
+using testing::run_command;
 
 std::string file_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

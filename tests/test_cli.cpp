@@ -5,6 +5,7 @@
 #include <meccano/geometry.hpp>
 #include <meccano/surface.hpp>
 
+#include <run_command.hpp>
 #include <test_surfaces.hpp>
 #include <vtu_reader.hpp>
 
@@ -19,7 +20,6 @@
 #include <map>
 #include <string>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 namespace meccano {
@@ -27,22 +27,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
+using CliRun = testing::CommandRun;
 
-CliRun run_cli(const std::string& arguments) {
-  const std::string command = std::string(MECCANO_CLI) + " " + arguments + " 2>&1";
-  CliRun run;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return run;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) run.output += buffer.data();
-  const int raw = ::pclose(pipe);
-  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return run;
-}
+CliRun run_cli(const std::string& arguments) { return testing::run_command(std::string(MECCANO_CLI) + " " + arguments); }
 
 class CliTest : public ::testing::Test {
  protected:

@@ -6,6 +6,7 @@
 #include <meccano/quality.hpp>
 #include <meccano/surface.hpp>
 
+#include <run_command.hpp>
 #include <test_surfaces.hpp>
 
 #include <gmsh.h>
@@ -23,7 +24,6 @@
 #include <string>
 #include <vector>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 namespace meccano {
@@ -31,21 +31,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct ToolRun {
-  int status = -1;
-  std::string output;  // stdout and stderr
-};
+using ToolRun = testing::CommandRun;
 
 ToolRun run_reference_gmsh(const std::string& arguments) {
-  const std::string command = std::string(MECCANO_REFERENCE_GMSH) + " " + arguments + " 2>&1";
-  ToolRun run;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return run;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) run.output += buffer.data();
-  const int raw = ::pclose(pipe);
-  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return run;
+  return testing::run_command(std::string(MECCANO_REFERENCE_GMSH) + " " + arguments);
 }
 
 using Face = std::array<std::size_t, 3>;  // node tags

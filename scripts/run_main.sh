@@ -7,6 +7,7 @@
 #   cube_example_quality.csv/.png   quality histograms before and after smoothing (the paper's Figure 6)
 #   cube_example_approximation.*    step 2 for inspection: the healed S_M before projection (and a picture)
 #   cube_example_projection.msh     step 3 for inspection: S_M projected onto S, tets still tangled
+#   convergence_p1.csv, convergence.png   the demo solver's small convergence study
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -34,4 +35,13 @@ print(f"  mean ratio against meccano:     min {q['meccano']['min']:.3f}  mean {q
 print(f"  mean ratio against equilateral: min {q['equilateral']['min']:.3f}  mean {q['equilateral']['mean']:.3f}")
 print(f"  dihedral angles {r['min_dihedral_deg']:.1f}° to {r['max_dihedral_deg']:.1f}°; {r['seconds']['total']:.2f} s in all")
 EOF
+# The deal.II demo (doc/solver.md): a Neumann (flux-jump) condition on the cube example's surface, on
+# the mesh above and in a small convergence study (3 levels, P1, up to about 470 k tets).
+if [ -x build/solver_demo/poisson_interface ]; then
+  build/solver_demo/poisson_interface --mesh out/cube_example.msh --interface patch --degree 1
+  build/solver_demo/convergence_study --levels 3 --degree 1 --csv out/convergence_p1.csv
+  /usr/bin/python3 scripts/plot_convergence.py out/convergence.png P1=out/convergence_p1.csv
+else
+  echo "main job: deal.II not found, the demo solver was not built"
+fi
 echo "main job: done; open out/*.msh in Gmsh, out/*.png in an image viewer"

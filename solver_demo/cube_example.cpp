@@ -1,0 +1,160 @@
+#include "cube_example.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace solver_demo {
+namespace {
+
+using std::numbers::pi;
+
+// Q = [origin, origin + side]² in (x, y); p, q are its unit coordinates.
+constexpr double origin = 0.2;
+constexpr double side = 0.6;
+
+// s = base + tilt p q + bump sin(πp) sin(πq), with its derivatives in physical coordinates.
+constexpr double base = 0.42;
+constexpr double tilt = 0.12;
+constexpr double bump = 0.10;
+
+struct Height {
+  double s, s_x, s_y, laplacian;
+};
+
+Height height(double x, double y) {
+  const double p = (x - origin) / side, q = (y - origin) / side;
+  const double sp = std::sin(pi * p), cp = std::cos(pi * p), sq = std::sin(pi * q), cq = std::cos(pi * q);
+  return {base + tilt * p * q + bump * sp * sq,
+          (tilt * q + bump * pi * cp * sq) / side,
+          (tilt * p + bump * pi * sp * cq) / side,
+          -2.0 * bump * pi * pi * sp * sq / (side * side)};
+}
+
+// The cutoff w = B³, B = 16 p(1−p) q(1−q) on Q and 0 outside. B vanishes linearly at the rim, so w
+// vanishes there with its first and second derivatives: u's kink term is C² across the rim's column.
+struct Cutoff {
+  double w, w_x, w_y, laplacian;
+};
+
+Cutoff cutoff(double x, double y) {
+  const double p = (x - origin) / side, q = (y - origin) / side;
+  if (p <= 0.0 || p >= 1.0 || q <= 0.0 || q >= 1.0) return {0.0, 0.0, 0.0, 0.0};
+  const double bp = 4.0 * p * (1.0 - p), bq = 4.0 * q * (1.0 - q);
+  const double B = bp * bq;
+  const double B_x = 4.0 * (1.0 - 2.0 * p) * bq / side, B_y = 4.0 * (1.0 - 2.0 * q) * bp / side;
+  const double B_laplacian = -8.0 * (bq + bp) / (side * side);
+  return {B * B * B, 3.0 * B * B * B_x, 3.0 * B * B * B_y,
+          6.0 * B * (B_x * B_x + B_y * B_y) + 3.0 * B * B * B_laplacian};
+}
+
+// The smooth part e^z sin(2x + y): nonzero on the box sides, −Δ of it is 4 times itself.
+ValueAndGradient smooth_part(const Eigen::Vector3d& p) {
+  const double e = std::exp(p.z()), s = std::sin(2.0 * p.x() + p.y()), c = std::cos(2.0 * p.x() + p.y());
+  return {e * s, {2.0 * e * c, e * c, e * s}};
+}
+
+Eigen::Vector3d triangle_normal(const InterfaceMesh& mesh, const std::array<unsigned int, 3>& t) {
+  const auto point = [&](int i) { return Eigen::Vector3d(mesh.points[t[i]].data()); };
+  return (point(1) - point(0)).cross(point(2) - point(0));
+}
+
+}  // namespace
+
+double cube_example_height(double x, double y) { return height(x, y).s; }
+
+Eigen::Vector3d cube_example_normal(double x, double y) {
+  const Height h = height(x, y);
+  return Eigen::Vector3d(-h.s_x, -h.s_y, 1.0).normalized();
+}
+
+ValueAndGradient manufactured_solution(const Eigen::Vector3d& p) {
+  ValueAndGradient u = smooth_part(p);
+  const Cutoff c = cutoff(p.x(), p.y());
+  if (c.w == 0.0) return u;
+  // Kink term k = −w |d|, d = z − s: ∇k = −σ (d ∇w + w ∇d) with ∇d = (−s_x, −s_y, 1).
+  const Height h = height(p.x(), p.y());
+  const double d = p.z() - h.s, sigma = d >= 0.0 ? 1.0 : -1.0;
+  u.value -= c.w * std::abs(d);
+  u.gradient -= sigma * (d * Eigen::Vector3d(c.w_x, c.w_y, 0.0) + c.w * Eigen::Vector3d(-h.s_x, -h.s_y, 1.0));
+  return u;
+}
+
+double manufactured_right_hand_side(const Eigen::Vector3d& p) {
+  const double smooth = 4.0 * smooth_part(p).value;
+  const Cutoff c = cutoff(p.x(), p.y());
+  if (c.w == 0.0) return smooth;
+  // −Δk = σ Δ(w d) = σ (d Δw + 2 ∇w·∇d + w Δd), with ∇w·∇d = −∇w·∇s and Δd = −Δs.
+  const Height h = height(p.x(), p.y());
+  const double d = p.z() - h.s, sigma = d >= 0.0 ? 1.0 : -1.0;
+  return smooth + sigma * (d * c.laplacian - 2.0 * (c.w_x * h.s_x + c.w_y * h.s_y) - c.w * h.laplacian);
+}
+
+double manufactured_interface_source(const Eigen::Vector3d& p) {
+  // On S, ∇k = ∓ w ∇d from above and below and ∇d = |∇d| n, so the jump ∂u/∂n|⁻ − ∂u/∂n|⁺ is 2 w |∇d|.
+  const Height h = height(p.x(), p.y());
+  return 2.0 * cutoff(p.x(), p.y()).w * std::sqrt(1.0 + h.s_x * h.s_x + h.s_y * h.s_y);
+}
+
+meccano::TriangleSurface triangulate_cube_example(int n) {
+  meccano::TriangleSurface surface;
+  surface.name = "patch";
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double x = origin + side * i / n, y = origin + side * j / n;
+      surface.points.emplace_back(x, y, cube_example_height(x, y));
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, b = a + 1, c = a + n + 2, d = a + n + 1;
+      if ((i + j) % 2 == 0) {
+        surface.triangles.push_back({a, b, c});
+        surface.triangles.push_back({a, c, d});
+      } else {
+        surface.triangles.push_back({a, b, d});
+        surface.triangles.push_back({b, c, d});
+      }
+    }
+  return surface;
+}
+
+SurfaceMatch match_cube_example_surface(const InterfaceMesh& mesh) {
+  SurfaceMatch match;
+  double edge_sum = 0.0;
+  for (const auto& t : mesh.interface)
+    for (int i = 0; i < 3; ++i)
+      edge_sum += (Eigen::Vector3d(mesh.points[t[i]].data()) - Eigen::Vector3d(mesh.points[t[(i + 1) % 3]].data())).norm();
+  match.tolerance = mesh.interface.empty() ? 0.0 : 0.05 * edge_sum / (3.0 * static_cast<double>(mesh.interface.size()));
+  for (const auto& t : mesh.interface)
+    for (const unsigned int v : t) {
+      const auto& [x, y, z] = mesh.points[v];
+      const bool over_q = x >= origin - match.tolerance && x <= origin + side + match.tolerance &&
+                          y >= origin - match.tolerance && y <= origin + side + match.tolerance;
+      match.max_deviation = std::max(match.max_deviation,
+                                     over_q ? std::abs(z - cube_example_height(x, y)) : std::numeric_limits<double>::infinity());
+    }
+  if (mesh.interface.empty()) match.max_deviation = std::numeric_limits<double>::infinity();
+  return match;
+}
+
+NormalError cube_example_normal_error(const InterfaceMesh& mesh) {
+  NormalError error;
+  double area_sum = 0.0, weighted_sum = 0.0;
+  for (const auto& t : mesh.interface) {
+    const Eigen::Vector3d normal = triangle_normal(mesh, t);
+    const Eigen::Vector3d centroid =
+        (Eigen::Vector3d(mesh.points[t[0]].data()) + Eigen::Vector3d(mesh.points[t[1]].data()) +
+         Eigen::Vector3d(mesh.points[t[2]].data())) / 3.0;
+    const double cosine = std::abs(normal.normalized().dot(cube_example_normal(centroid.x(), centroid.y())));
+    const double angle = std::acos(std::min(1.0, cosine)) * 180.0 / pi;
+    error.per_triangle_deg.push_back(angle);
+    error.max_deg = std::max(error.max_deg, angle);
+    area_sum += normal.norm();
+    weighted_sum += normal.norm() * angle;
+  }
+  error.mean_deg = area_sum > 0.0 ? weighted_sum / area_sum : 0.0;
+  return error;
+}
+
+}  // namespace solver_demo

@@ -2,7 +2,7 @@
 # Builds the libFuzzer targets (clang, MECCANO_FUZZ: ASan + UBSan + libFuzzer) and runs each for a
 # number of seconds on its seed corpus; fails on the first crash, hang, leak or oversized allocation.
 #
-# Usage: tests/fuzz/run_fuzz.sh [seconds per target, default 60] [build-dir, default /tmp/build-fuzz]
+# Usage: tests/fuzz/run_fuzz.sh [seconds per target, default 60] [build-dir, default build-fuzz/ in the checkout]
 #
 # New inputs that libFuzzer finds go to <build-dir>/corpus/<target>/ (the seeds under
 # tests/fuzz/corpus/ stay as they are); a crashing input is saved as <build-dir>/artifacts/<target>-*
@@ -10,7 +10,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 seconds=${1:-60}
-build=${2:-/tmp/build-fuzz}
+build=${2:-build-fuzz}
 jobs=$(( $(nproc) < 2 ? $(nproc) : 2 ))
 targets=(fuzz_read_obj fuzz_read_stl fuzz_read_off fuzz_read_msh fuzz_validate_surface)
 

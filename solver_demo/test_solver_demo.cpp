@@ -12,6 +12,7 @@
 #include <meccano/surface.hpp>
 
 #include <run_command.hpp>
+#include <scratch_directory.hpp>
 
 #include <gtest/gtest.h>
 
@@ -163,17 +164,9 @@ bool positively_oriented(const InterfaceMesh& mesh) {
   });
 }
 
-class DemoFiles : public ::testing::Test {
+class DemoFiles : public meccano::testing::ScratchDirectoryTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("solver-demo-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
-  fs::path dir_;
+  DemoFiles() : ScratchDirectoryTest("solver-demo") {}
 };
 
 using InterfaceMeshTest = DemoFiles;

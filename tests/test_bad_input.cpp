@@ -40,6 +40,7 @@
 #include <meccano/pipeline.hpp>
 #include <meccano/surface.hpp>
 
+#include <scratch_directory.hpp>
 #include <test_surfaces.hpp>
 
 #include <gtest/gtest.h>
@@ -62,16 +63,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class BadInput : public ::testing::Test {
+class BadInput : public testing::ScratchDirectoryTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("meccano-bad-input-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+  BadInput() : ScratchDirectoryTest("meccano-bad-input") {
     patch_ = testing::paper_like_patch(6);
     patch_.name = "patch";
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   // The message of the InputError that insert_surfaces throws, or "" if it does not throw one.
   std::string insertion_error(const InsertionOptions& options) const {
@@ -93,7 +90,6 @@ class BadInput : public ::testing::Test {
     return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   }
 
-  fs::path dir_;
   TriangleSurface patch_;
 };
 

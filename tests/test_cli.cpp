@@ -6,6 +6,7 @@
 #include <meccano/surface.hpp>
 
 #include <run_command.hpp>
+#include <scratch_directory.hpp>
 #include <test_surfaces.hpp>
 #include <vtu_reader.hpp>
 
@@ -31,17 +32,9 @@ using CliRun = testing::CommandRun;
 
 CliRun run_cli(const std::string& arguments) { return testing::run_command(std::string(MECCANO_CLI) + " " + arguments); }
 
-class CliTest : public ::testing::Test {
+class CliTest : public testing::ScratchDirectoryTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("meccano-cli-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  CliTest() : ScratchDirectoryTest("meccano-cli") {}
 
   std::string write_obj(const std::string& name, const TriangleSurface& surface) const {
     std::ofstream out(path(name));
@@ -60,8 +53,6 @@ class CliTest : public ::testing::Test {
   bool only_inputs_in_directory(std::size_t inputs) const {
     return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir_), fs::directory_iterator())) == inputs;
   }
-
-  fs::path dir_;
 };
 
 std::map<std::string, std::size_t> group_sizes(const std::string& file) {

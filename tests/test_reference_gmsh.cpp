@@ -7,6 +7,7 @@
 #include <meccano/surface.hpp>
 
 #include <run_command.hpp>
+#include <scratch_directory.hpp>
 #include <test_surfaces.hpp>
 
 #include <gmsh.h>
@@ -121,18 +122,9 @@ double number_after(const std::string& text, const std::string& key) {
 }
 
 // A temporary directory per test, for the runs that check options and failures.
-class ReferenceGmshCliTest : public ::testing::Test {
+class ReferenceGmshCliTest : public testing::ScratchDirectoryTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("meccano-reference-gmsh-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
-  fs::path dir_;
+  ReferenceGmshCliTest() : ScratchDirectoryTest("meccano-reference-gmsh") {}
 };
 
 // One run on the cube example at --size 0.1, shared by the tests that inspect its output.

@@ -185,8 +185,6 @@ std::vector<SideRule> other_side_rules(const InsertionResult& result, std::span<
 
 }  // namespace
 
-// A surface whose S_M cannot be untangled on one side of S may be on the other: the whole insertion is
-// run again from the input mesh with those surfaces' S_M on their other side, as healing itself does.
 std::int64_t estimate_tets(std::int64_t meccano_tets, std::span<const TriangleSurface> surfaces, double resolution) {
   constexpr double tets_per_area = 185.0;  // per l_r², see pipeline.hpp
   double area = 0.0;
@@ -210,6 +208,8 @@ void check_tet_estimate(std::int64_t estimated_tets, std::int64_t max_tets, cons
   throw InputError(message.str());
 }
 
+// A surface whose S_M cannot be untangled on one side of S may be on the other: the whole insertion is
+// run again from the input mesh with those surfaces' S_M on their other side, as healing itself does.
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();
   if (!surfaces.empty()) {

@@ -180,6 +180,8 @@ class Smoother {
   bool optimise(VertexId v);
   void store(VertexId v, const Placement& at);
   SweepRecord measure() const;
+  // The exponent p of Σ η*^p: the paper's 1 while tangled, options_.power once a sweep ends untangled.
+  double power() const { return tangled_ ? 1.0 : options_.power; }
 
   TetMesh& mesh_;
   std::span<SurfaceProjection* const> surfaces_;
@@ -193,7 +195,6 @@ class Smoother {
   std::vector<TetId> active_tets_;
   SmoothingStats stats_;
   bool tangled_ = true;               // did the last sweep end with inverted tets (or none ran yet)?
-  double power_ = 1.0;                // the exponent p of Σ η*^p: 1 while tangled, options_.power after
   double untangling_epsilon_ = 1e-3;  // ε / mean|σ|, raised while untangling stalls
 };
 
@@ -292,7 +293,7 @@ double Smoother::star_objective(VertexId v, const Vector3d& x, double delta) con
   int local = 0;
   for (TetId t : stars_.of(v)) {
     const Matrix3d s = s_matrix(t, v, x, local);
-    value += raise(regularised_distortion(s.squaredNorm(), s.determinant(), delta), power_);
+    value += raise(regularised_distortion(s.squaredNorm(), s.determinant(), delta), power());
   }
   return value;
 }
@@ -302,7 +303,7 @@ Distortion Smoother::star_derivatives(VertexId v, const Vector3d& x, double delt
   int local = 0;
   for (TetId t : stars_.of(v)) {
     const Matrix3d s = s_matrix(t, v, x, local);
-    add_power(distortion_derivatives(s, target_inverse_[t], local, delta), power_, sum);
+    add_power(distortion_derivatives(s, target_inverse_[t], local, delta), power(), sum);
   }
   return sum;
 }
@@ -494,7 +495,7 @@ SweepRecord Smoother::measure() const {
     record.inverted += q == 0.0;
     record.min_quality = std::min(record.min_quality, q);
     record.mean_quality += q;
-    record.objective += raise(eta, power_);
+    record.objective += raise(eta, power());
   }
   if (count > 0) record.mean_quality /= static_cast<double>(count);
   return record;
@@ -547,15 +548,14 @@ SmoothingStats Smoother::run() {
     SweepRecord record = measure();
     record.nodes_optimised = optimised;
     record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    record.power = power_;
+    record.power = power();
     // The objective can only be compared with the previous sweep's if both used the same power.
-    const bool comparable = !stats_.sweeps.empty() && stats_.sweeps.back().power == power_ &&
+    const bool comparable = !stats_.sweeps.empty() && stats_.sweeps.back().power == power() &&
                             stats_.sweeps.back().inverted == 0;
     const double previous_objective = comparable ? stats_.sweeps.back().objective : infinity;
     stats_.sweeps.push_back(record);
     // Untangling uses the paper's sum; once a sweep ends untangled, the next ones weigh bad tets more.
     tangled_ = record.inverted > 0;
-    power_ = tangled_ ? 1.0 : options_.power;
     if (record.inverted > 0) {
       // Stalled untangling: the tangled stars sit in local minima of a steep objective. A larger ε
       // (a larger δ where stars are tangled) flattens it so that nodes can pass through.

@@ -27,6 +27,7 @@ void write_surface(JsonWriter& json, const SurfaceInsertion& inserted, Stage las
   json.key("volumetric").begin_object();
   json.key("tets").value(v.tets).key("tets_meeting_surface").value(v.tets_intersecting);
   json.key("refinement_passes").value(v.refinement_passes).key("bisections").value(v.bisections);
+  json.key("growth_passes").value(v.growth_passes).key("band_tets").value(v.band_tets);
   json.key("seconds").value(inserted.volumetric_seconds).end_object();
   if (last_stage >= Stage::approximation) {
     const HealingStats& h = inserted.healing_stats;

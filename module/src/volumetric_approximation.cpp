@@ -5,6 +5,8 @@
 #include "topology_helpers.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <numeric>
 #include <string>
 
@@ -246,29 +248,44 @@ void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& o
   // not finer than l_r, or (given S) has a node farther than l_r from S, is bisected instead of added:
   // adding coarse tets would pull far-away, coarse parts of the mesh into V_M (each brings new oblique
   // faces and pinched nodes further out), and far nodes would become nodes of S_M far from S.
-  std::vector<std::int8_t> near_surface;  // per vertex: 1 near, 0 far, -1 not computed yet
-  auto too_far = [&](TetId t) {
-    if (!surface) return false;
-    near_surface.resize(mesh.points.size(), -1);
+  // Where the growth must cross the offset at distance l_r, bisection alone never ends: a tet straddling
+  // it keeps a child that straddles it, and the front refines without limit. So a tet finer than
+  // l_r / 16 is added when its nodes are within the band l_r (1 + 1/16) of S, and the growth fails if
+  // it needs one that reaches beyond the band.
+  const double finest_growth_edge = options.resolution * (growth_band - 1.0);
+  const double band = options.resolution * growth_band;
+  std::vector<double> distance_to_surface;  // per vertex; NaN: not computed yet
+  auto farthest_node = [&](TetId t) {
+    distance_to_surface.resize(mesh.points.size(), std::numeric_limits<double>::quiet_NaN());
+    double farthest = 0.0;
     for (VertexId v : mesh.tets[t]) {
-      if (near_surface[v] < 0)
-        near_surface[v] = surface->closest_point(mesh.points[v]).squared_distance <
-                          options.resolution * options.resolution;
-      if (!near_surface[v]) return true;
+      if (std::isnan(distance_to_surface[v]))
+        distance_to_surface[v] = std::sqrt(surface->closest_point(mesh.points[v]).squared_distance);
+      farthest = std::max(farthest, distance_to_surface[v]);
     }
-    return false;
+    return farthest;
   };
   auto grow = [&](const std::vector<TetId>& wanted) -> std::int64_t {
     std::vector<TetId> coarse;
     std::int64_t added = 0;
     for (TetId t : wanted) {
       if (region[t]) continue;
-      if (mesh.longest_edge(t) >= options.resolution || too_far(t)) {
+      const double edge = mesh.longest_edge(t);
+      const double farthest = surface && edge < options.resolution ? farthest_node(t) : 0.0;
+      if (edge >= options.resolution || (farthest >= options.resolution && edge >= finest_growth_edge)) {
         coarse.push_back(t);
-      } else {
-        region[t] = 1;
-        ++added;
+        continue;
       }
+      if (farthest >= band) {
+        const Eigen::Vector3d at = mesh.points[mesh.tets[t][0]];
+        throw MeshingError("the volumetric approximation cannot be grown into a ball within l_r of the surface "
+                           "near (" + std::to_string(at.x()) + ", " + std::to_string(at.y()) + ", " +
+                           std::to_string(at.z()) + "): the ball must reach " + std::to_string(farthest / options.resolution) +
+                           " l_r from it; a smaller l_r resolves this part of the surface");
+      }
+      stats.band_tets += farthest >= options.resolution;
+      region[t] = 1;
+      ++added;
     }
     if (!coarse.empty()) {
       std::sort(coarse.begin(), coarse.end());

@@ -12,7 +12,10 @@
 //             (components of the complement that V_M encloses) are filled.
 //          In steps 2 and 3 a tet to be added whose longest edge is l_r or more, or with a node farther
 //          than l_r from S, is bisected instead (and the step repeats), so V_M stays made of tets
-//          finer than l_r with every node within l_r of S.
+//          finer than l_r with every node within l_r of S. Where the growth has to cross the offset at
+//          distance l_r, that bisection would never end (a tet straddling the offset always has a child
+//          straddling it): a tet finer than l_r / 16 is added if its nodes are within the band
+//          l_r (1 + 1/16), and the growth fails if it needs one reaching beyond the band.
 //          3. Grow V_M until every boundary face lies on a coordinate plane in computational
 //             coordinates, by adding the tet across each face that does not; step 2 is then re-run,
 //             until neither step changes V_M. If V_M then has disk links everywhere but a boundary
@@ -22,8 +25,9 @@
 // Invariants on return (check_ball): V_M is face-connected, every boundary node has a disk link, the
 //          boundary is one closed 2-manifold with Euler characteristic 2, every boundary face is
 //          axis-parallel; every tet meeting S is in V_M and has l_T < l_r; every node of V_M is within
-//          l_r of S.
-// Errors   InputError for l_r <= 0; MeshingError if V_M cannot be made a ball within the pass limit.
+//          l_r of S, or within l_r (1 + 1/16) at a node of a tet added in the band (counted in band_tets).
+// Errors   InputError for l_r <= 0; MeshingError if V_M cannot be made a ball within the pass limit, or
+//          only by reaching beyond the band (the message names where).
 #pragma once
 
 #include <meccano/bisection.hpp>
@@ -34,6 +38,10 @@
 #include <vector>
 
 namespace meccano {
+
+// Where V_M's growth crosses the offset of S at distance l_r, it stops bisecting at tets finer than
+// l_r / 16 and adds them if their nodes are within this multiple of l_r (see step 2-3 above).
+inline constexpr double growth_band = 1.0 + 1.0 / 16.0;
 
 // Per-tet flag of a region of the mesh (V_M); kept in step with refinement by region_follows_children.
 using TetRegion = std::vector<std::uint8_t>;
@@ -56,7 +64,8 @@ struct VolumetricStats {
   std::int64_t cavity_tets = 0;
   std::int64_t axis_tets = 0;          // tets added to make the boundary axis-parallel
   int thickening_layers = 0;           // layers added to close handles the link test cannot see
-  int growth_refinements = 0;          // times the growth bisected tets not finer than l_r
+  int growth_refinements = 0;          // times the growth bisected tets (coarse, or with nodes beyond l_r)
+  std::int64_t band_tets = 0;          // tets finer than l_r / 16 added with a node beyond l_r (within the band)
   int growth_passes = 0;
   std::int64_t tets = 0;               // tets of V_M at the end
 };
@@ -66,7 +75,7 @@ TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const Vo
                              VolumetricStats& stats, std::vector<TetRegion*> other_regions = {});
 
 // Steps 2-3 alone, on any non-empty region: grows it into a ball with axis-parallel boundary faces.
-// Given S, the tets added also keep every node within l_r of S.
+// Given S, the tets added also keep every node within l_r of S (or the band, as above).
 void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& options, VolumetricStats& stats,
                     std::vector<TetRegion*> other_regions = {}, const TriangleBVH* surface = nullptr);
 

@@ -9,8 +9,10 @@
 // (within 1e-9 of the box diagonal), and every S_M a disk. Output: one line per case, then a Markdown
 // table of outcomes and reasons.
 //
-// Usage: stress_surfaces [--seed S] [--cases K] [--first I] [--threads T]
-// Case i depends only on (S, i): `--first i --cases 1` reruns it alone.
+// Usage: stress_surfaces [--seed S] [--cases K] [--first I] [--threads T] [--dump DIR]
+// Case i depends only on (S, i): `--first i --cases 1` reruns it alone; --dump writes each case's surfaces
+// to DIR/case<i>_<name>.obj with the meccano-immerse command that inserts them, to reproduce it there.
+#include <meccano/atomic_file.hpp>
 #include <meccano/box.hpp>
 #include <meccano/cube_meccano.hpp>
 #include <meccano/error.hpp>
@@ -47,6 +49,7 @@ struct Options {
   int cases = 100;
   int first = 0;
   int threads = 0;
+  std::string dump_directory;  // empty: no dump
 };
 
 Options parse_options(int argc, char** argv) {
@@ -62,8 +65,9 @@ Options parse_options(int argc, char** argv) {
     else if (arg == "--cases") options.cases = std::stoi(value);
     else if (arg == "--first") options.first = std::stoi(value);
     else if (arg == "--threads") options.threads = std::stoi(value);
+    else if (arg == "--dump") options.dump_directory = value;
     else {
-      std::cerr << "stress_surfaces: unknown option " << arg << " (--seed, --cases, --first, --threads)\n";
+      std::cerr << "stress_surfaces: unknown option " << arg << " (--seed, --cases, --first, --threads, --dump)\n";
       std::exit(2);
     }
   }
@@ -198,6 +202,22 @@ std::string defects_of(const meccano::InsertionResult& result, const std::vector
   return out.str();
 }
 
+// Writes the case's surfaces as OBJ files and prints the meccano-immerse command that inserts them.
+void dump_case(const std::string& directory, int c, const std::vector<TriangleSurface>& surfaces, double resolution) {
+  std::ostringstream command;
+  command << std::setprecision(17) << "meccano-immerse --box 0,0,0,1,1,1 --resolution " << resolution;
+  for (const TriangleSurface& surface : surfaces) {
+    const std::string path = directory + "/case" + std::to_string(c) + "_" + surface.name + ".obj";
+    meccano::write_file_atomically(path, [&](std::ostream& out) {
+      out << std::setprecision(17);
+      for (const Eigen::Vector3d& p : surface.points) out << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+      for (const auto& t : surface.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    });
+    command << " --surface " << path << ':' << surface.name;
+  }
+  std::cout << "case " << c << ": " << command.str() << " --output case" << c << ".msh" << std::endl;
+}
+
 std::string one_decimal(double value) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(1) << value;
@@ -231,6 +251,7 @@ int main(int argc, char** argv) {
     std::vector<TriangleSurface> surfaces;
     for (int s = 0; s < surface_count; ++s)
       surfaces.push_back(random_surface(rng, 0.5 * resolution, "s" + std::to_string(s + 1)));
+    if (!options.dump_directory.empty()) dump_case(options.dump_directory, c, surfaces, resolution);
 
     Outcome outcome = Outcome::accepted_ok;
     std::string detail;

@@ -6,6 +6,7 @@
 #include <meccano/cube_meccano.hpp>
 #include <meccano/error.hpp>
 #include <meccano/mesh_check.hpp>
+#include <meccano/surface.hpp>
 #include <meccano/surface_approximation.hpp>
 
 #include <test_surfaces.hpp>
@@ -92,6 +93,21 @@ TEST(SurfaceApproximation, HealingStatisticsCountTheRules) {
   EXPECT_GT(stats.dividing_edges, 0);
   EXPECT_GT(stats.passes, 1);
   EXPECT_EQ(stats.faces, check_surface_approximation(mesh, region, 0).faces);
+}
+
+// Filling a reflex rim corner made corbels here whose removal brought the corner back: healing cycled
+// (fill, remove corbels) until its pass limit. Each corner is now filled once at most.
+TEST(SurfaceApproximation, ReflexCornersAreFilledOnceSoHealingEnds) {
+  const TriangleSurface surface = read_surface(std::string(MECCANO_TEST_DATA_DIR) + "/disk_fill_corbel_cycle.obj");
+  TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
+  const TriangleBVH tree(surface);
+  VolumetricStats volumetric_stats;
+  TetRegion region = approximate_volume(mesh, tree, {0.031441647624062763}, volumetric_stats);
+  const HealingStats stats = approximate_surface(mesh, region, surface, tree, 0);
+  EXPECT_GT(stats.reflex_corners_filled, 0);
+  const SurfaceApproximationCheck check = check_surface_approximation(mesh, region, 0);
+  EXPECT_TRUE(check.healed()) << check.describe();
+  EXPECT_TRUE(check.is_disk()) << check.describe();
 }
 
 TEST(SurfaceApproximation, CheckDetectsUnhealedConfigurations) {

@@ -584,7 +584,8 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
 
   std::vector<TetRegion*> regions = other_regions;
   regions.push_back(&volumetric);
-  std::vector<VertexId> left_reflex;  // sorted: reflex rim corners that could not be filled
+  std::vector<VertexId> left_reflex;    // sorted: reflex rim corners that could not be filled
+  std::vector<VertexId> filled_reflex;  // sorted: reflex rim corners filled once
   for (stats.passes = 1; stats.passes <= options.max_healing_passes; ++stats.passes) {
     const auto [stray, holes] = keep_one_component_without_holes(mesh, volumetric, tag);
     stats.stray_faces += stray;
@@ -602,6 +603,7 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
     // there when those lie on this side of S or beyond its rim. Otherwise it is left as it is: the
     // paper removes it, but the notch a removal cuts has reflex corners of its own and grows until it
     // has eaten S_M (doc/results.md); a reflex fan only costs some squeezing at one rim node.
+    // A node is filled once at most: a fill can make corbels whose removal brings the corner back.
     const std::vector<VertexId> reflex_corners = reflex_rim_corners(mesh, s);
     std::int64_t filled_now = 0;
     if (!reflex_corners.empty()) {
@@ -609,7 +611,8 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
       for (VertexId node : reflex_corners) {
         if (std::binary_search(left_reflex.begin(), left_reflex.end(), node)) continue;
         const auto missing = missing_squares_at(mesh, volumetric, incidence, node, tag);
-        const bool can_fill = !missing.empty() && std::all_of(missing.begin(), missing.end(), [&](const FaceRef& f) {
+        const bool filled_before = std::binary_search(filled_reflex.begin(), filled_reflex.end(), node);
+        const bool can_fill = !filled_before && !missing.empty() && std::all_of(missing.begin(), missing.end(), [&](const FaceRef& f) {
           const auto nodes_of_face = face_nodes(mesh, f.tet, f.local_face);
           return std::all_of(nodes_of_face.begin(), nodes_of_face.end(), [&](VertexId v) { return side_of(v) != -side; });
         });
@@ -617,6 +620,7 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
           for (const FaceRef& f : missing) set_face_tag(mesh, f.tet, f.local_face, tag);
           filled_now += static_cast<std::int64_t>(missing.size());
           ++stats.reflex_corners_filled;
+          filled_reflex.insert(std::upper_bound(filled_reflex.begin(), filled_reflex.end(), node), node);
         } else {
           left_reflex.insert(std::upper_bound(left_reflex.begin(), left_reflex.end(), node), node);
         }

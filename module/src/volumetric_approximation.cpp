@@ -250,9 +250,9 @@ void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& o
   // faces and pinched nodes further out), and far nodes would become nodes of S_M far from S.
   // Where the growth must cross the offset at distance l_r, bisection alone never ends: a tet straddling
   // it keeps a child that straddles it, and the front refines without limit. So a tet finer than
-  // l_r / 16 is added when its nodes are within the band l_r (1 + 1/16) of S, and the growth fails if
-  // it needs one that reaches beyond the band.
-  const double finest_growth_edge = options.resolution * (growth_band - 1.0);
+  // l_r / 16 is added when its nodes are within the band 1.125 l_r of S, and the growth fails if it
+  // needs one that reaches beyond the band.
+  const double finest_edge = options.resolution * finest_growth_edge;
   const double band = options.resolution * growth_band;
   std::vector<double> distance_to_surface;  // per vertex; NaN: not computed yet
   auto farthest_node = [&](TetId t) {
@@ -272,7 +272,7 @@ void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& o
       if (region[t]) continue;
       const double edge = mesh.longest_edge(t);
       const double farthest = surface && edge < options.resolution ? farthest_node(t) : 0.0;
-      if (edge >= options.resolution || (farthest >= options.resolution && edge >= finest_growth_edge)) {
+      if (edge >= options.resolution || (farthest >= options.resolution && edge >= finest_edge)) {
         coarse.push_back(t);
         continue;
       }

@@ -15,7 +15,7 @@
 //          finer than l_r with every node within l_r of S. Where the growth has to cross the offset at
 //          distance l_r, that bisection would never end (a tet straddling the offset always has a child
 //          straddling it): a tet finer than l_r / 16 is added if its nodes are within the band
-//          l_r (1 + 1/16), and the growth fails if it needs one reaching beyond the band.
+//          1.125 l_r, and the growth fails if it needs one reaching beyond the band.
 //          3. Grow V_M until every boundary face lies on a coordinate plane in computational
 //             coordinates, by adding the tet across each face that does not; step 2 is then re-run,
 //             until neither step changes V_M. If V_M then has disk links everywhere but a boundary
@@ -25,7 +25,7 @@
 // Invariants on return (check_ball): V_M is face-connected, every boundary node has a disk link, the
 //          boundary is one closed 2-manifold with Euler characteristic 2, every boundary face is
 //          axis-parallel; every tet meeting S is in V_M and has l_T < l_r; every node of V_M is within
-//          l_r of S, or within l_r (1 + 1/16) at a node of a tet added in the band (counted in band_tets).
+//          l_r of S, or within 1.125 l_r at a node of a tet added in the band (counted in band_tets).
 // Errors   InputError for l_r <= 0; MeshingError if V_M cannot be made a ball within the pass limit, or
 //          only by reaching beyond the band (the message names where).
 #pragma once
@@ -40,8 +40,9 @@
 namespace meccano {
 
 // Where V_M's growth crosses the offset of S at distance l_r, it stops bisecting at tets finer than
-// l_r / 16 and adds them if their nodes are within this multiple of l_r (see step 2-3 above).
-inline constexpr double growth_band = 1.0 + 1.0 / 16.0;
+// finest_growth_edge * l_r and adds them if their nodes are within growth_band * l_r of S (steps 2-3).
+inline constexpr double finest_growth_edge = 1.0 / 16.0;
+inline constexpr double growth_band = 1.125;
 
 // Per-tet flag of a region of the mesh (V_M); kept in step with refinement by region_follows_children.
 using TetRegion = std::vector<std::uint8_t>;

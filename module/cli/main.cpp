@@ -7,6 +7,7 @@
 #include <meccano/mesh_check.hpp>
 #include <meccano/mesh_io.hpp>
 #include <meccano/msh_check.hpp>
+#include <meccano/msh_measure.hpp>
 #include <meccano/pipeline.hpp>
 #include <meccano/surface.hpp>
 #include <meccano/surface_validation.hpp>
@@ -32,6 +33,7 @@ namespace {
 
 constexpr const char* usage_text = R"(Usage: meccano-immerse --box X0,Y0,Z0,X1,Y1,Z1 [options] --output FILE
        meccano-immerse check FILE.msh [--report FILE.json] [--quiet]
+       meccano-immerse measure FILE.msh [--surface FILE[:NAME] ...] [--report FILE.json] [--quiet]
 
 Builds the meccano tetrahedral mesh of a box (equal cells as close to cubes as possible, 6 Kuhn tets
 per cell, refined uniformly by Kossaczky bisection) and inserts immersed surfaces into it.
@@ -91,6 +93,18 @@ file has those groups) and every interface_* group (interior faces forming a con
 disk). It prints one line per check (--quiet: nothing), writes them as JSON with --report, and exits 0
 if every check passes, 1 if one fails or the file cannot be read.
 
+measure FILE.msh measures a tet mesh in any Gmsh MSH file the same way whatever made it (this tool,
+reference-gmsh, TetGen, ...): nodes, tets, inverted tets, the equilateral mean ratio (min, mean, std,
+tets below 0.1, 0.2, 0.3), the dihedral angle range, and per 2D group interface_NAME its faces and
+area. Each --surface FILE[:NAME] (NAME as above: its 1-based position by default) is compared with
+interface_NAME: node distance to S (max, mean), two-sided Hausdorff distance (sampled at 1/8 of each
+triangle's edges), normal deviation (max, area-weighted mean; faces pointing against S's normal are
+counted apart as flipped) and area ratio. It prints them (--quiet: nothing), writes them as JSON with
+--report (keys: file, nodes, tets, inverted, quality.equilateral.{min, mean, std, below_0.1, below_0.2,
+below_0.3}, quality.min_dihedral_deg / max_dihedral_deg, interfaces[].{name, faces, area, surface,
+node_distance.{max, mean}, hausdorff, normal_deviation_deg.{max, mean}, flipped_faces, area_ratio}),
+and exits 0, or 1 if a file cannot be read or a surface has no interface_NAME group in the mesh.
+
 Examples:
   meccano-immerse --box 0,0,0,1,1,1 --level 9 --output cube.msh
   meccano-immerse --box 0,0,0,2,1,1 --level 6 --output bar.msh      (two unit cells)
@@ -100,6 +114,7 @@ Examples:
   meccano-immerse --box 0,0,0,1,1,1 --surface patch.obj:fault --resolution 0.03 \
                   --stage volumetric --output fault_vm.msh
   meccano-immerse check fault.msh --report fault_check.json
+  meccano-immerse measure fault.msh --surface patch.obj:fault --report fault_measure.json
 )";
 
 struct UsageError : std::runtime_error {
@@ -393,36 +408,73 @@ int run(const Options& options) {
   return 0;
 }
 
-// meccano-immerse check FILE.msh [--report FILE.json] [--quiet]: 0 if every check passes, 1 otherwise.
-int run_check(const std::vector<std::string>& args) {
-  std::optional<std::string> file, report;
+// The arguments of the subcommands that read one mesh file: FILE.msh [--report FILE.json] [--quiet], and
+// --surface FILE[:NAME] ... for those that take surfaces.
+struct FileCommand {
+  std::string file;
+  std::optional<std::string> report;
+  std::vector<std::pair<std::string, std::string>> surfaces;  // file, name
   bool quiet = false;
+};
+
+FileCommand parse_file_command(const std::string& command, const std::vector<std::string>& args, bool takes_surfaces) {
+  FileCommand parsed;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw UsageError(command + ": " + arg + " needs a value");
+      return args[++i];
+    };
     if (arg == "--help" || arg == "-h") {
       std::cout << usage_text;
-      return 0;
+      std::exit(0);
     } else if (arg == "--report") {
-      if (i + 1 >= args.size()) throw UsageError("check: --report needs a value");
-      report = args[++i];
+      parsed.report = value();
+    } else if (arg == "--surface" && takes_surfaces) {
+      parsed.surfaces.push_back(parse_surface(value(), parsed.surfaces.size() + 1));
     } else if (arg == "--quiet" || arg == "-q") {
-      quiet = true;
+      parsed.quiet = true;
     } else if (arg.starts_with('-')) {
-      throw UsageError("check: unknown option '" + arg + "'");
-    } else if (file) {
-      throw UsageError("check takes one mesh file, got '" + *file + "' and '" + arg + "'");
+      throw UsageError(command + ": unknown option '" + arg + "'");
+    } else if (!parsed.file.empty()) {
+      throw UsageError(command + " takes one mesh file, got '" + parsed.file + "' and '" + arg + "'");
     } else {
-      file = arg;
+      parsed.file = arg;
     }
   }
-  if (!file) throw UsageError("check needs a mesh file: meccano-immerse check FILE.msh");
-  const meccano::MeshFileCheck result = meccano::check_mesh_file(*file);
-  if (!quiet) std::cout << result.text();
-  if (report) {
+  if (parsed.file.empty()) throw UsageError(command + " needs a mesh file: meccano-immerse " + command + " FILE.msh");
+  return parsed;
+}
+
+// Prints the text (unless --quiet) and writes the JSON report (with --report) of a subcommand's result.
+template <class Result>
+void publish(const FileCommand& command, const Result& result) {
+  if (!command.quiet) std::cout << result.text();
+  if (command.report) {
     const std::string json = result.json();
-    meccano::write_file_atomically(*report, [&json](std::ostream& out) { out << json; });
+    meccano::write_file_atomically(*command.report, [&json](std::ostream& out) { out << json; });
   }
+}
+
+// meccano-immerse check FILE.msh [--report FILE.json] [--quiet]: 0 if every check passes, 1 otherwise.
+int run_check(const std::vector<std::string>& args) {
+  const FileCommand command = parse_file_command("check", args, false);
+  const meccano::MeshFileCheck result = meccano::check_mesh_file(command.file);
+  publish(command, result);
   return result.passed() ? 0 : 1;
+}
+
+// meccano-immerse measure FILE.msh [--surface FILE[:NAME] ...] [--report FILE.json] [--quiet]: 0 once
+// measured.
+int run_measure(const std::vector<std::string>& args) {
+  const FileCommand command = parse_file_command("measure", args, true);
+  std::vector<meccano::TriangleSurface> surfaces;
+  for (const auto& [file, name] : command.surfaces) {
+    surfaces.push_back(meccano::read_surface(file));
+    surfaces.back().name = name;
+  }
+  publish(command, meccano::measure_mesh_file(command.file, surfaces));
+  return 0;
 }
 
 }  // namespace
@@ -430,6 +482,7 @@ int run_check(const std::vector<std::string>& args) {
 int main(int argc, char** argv) {
   try {
     if (argc > 1 && std::string(argv[1]) == "check") return run_check({argv + 2, argv + argc});
+    if (argc > 1 && std::string(argv[1]) == "measure") return run_measure({argv + 2, argv + argc});
     return run(parse_options(argc, argv));
   } catch (const UsageError& error) {
     std::cerr << "meccano-immerse: " << error.what() << "\n(see meccano-immerse --help)\n";

@@ -6,18 +6,23 @@
 #include "interface_mesh.hpp"
 #include "interface_poisson.hpp"
 
+#include <meccano/atomic_file.hpp>
+#include <meccano/json_writer.hpp>
+
 #include <deal.II/base/mpi.h>
 
 #include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 
 namespace {
 
 using namespace solver_demo;
 
 constexpr const char* usage = R"(Usage: poisson_interface --mesh FILE.msh [--interface NAME] [--degree 1|2] [--vtu PREFIX]
+                         [--report FILE.json]
 
 Solves -Δu = f in the mesh's domain, u = g_D on its boundary, with the flux jump
 du/dn|below - du/dn|above = g_S on the immersed surface S (the triangles of the 2D physical group
@@ -36,9 +41,45 @@ Options:
   --degree 1|2        polynomial degree (default 1)
   --vtu PREFIX        write PREFIX.vtu (u_h, and u_h - I_h u where u is known; PREFIX.pvtu and
                       PREFIX.RANK.vtu under MPI) and PREFIX_interface.vtu (S's triangles)
+  --report FILE.json  the run as JSON (rank 0 writes it): mesh, interface, degree, cells, dofs, h,
+                      cg_iterations, manufactured (true or false), errors {l2, h1} and
+                      normal_angle_deg {max, mean} for the manufactured problem, norms {l2,
+                      h1_seminorm}, flux {source, outflow, relative_difference}, seconds {read, setup,
+                      assembly, solve, postprocess, total} and ranks
 
 Runs under MPI as well: mpirun -np 2 poisson_interface --mesh FILE.msh
 )";
+
+double relative_flux_difference(const SolveReport& report) {
+  return std::abs(report.outflow - report.source) / std::abs(report.source);
+}
+
+// The run as JSON: the numbers the text output prints, at full precision.
+void write_report(const std::string& path, const Options& options, const InterfaceMesh& mesh, unsigned int degree,
+                  const SolveReport& report, const std::optional<NormalError>& normals, double read_seconds,
+                  double total_seconds, unsigned int ranks) {
+  meccano::JsonWriter json;
+  json.begin_object().key("mesh").value(options.at("--mesh"));
+  json.key("interface").value("interface_" + mesh.interface_name);
+  json.key("degree").value(degree).key("cells").value(report.cells).key("dofs").value(report.dofs);
+  json.key("h").value(report.h).key("cg_iterations").value(report.cg_iterations);
+  json.key("manufactured").value(normals.has_value());  // the normals are measured against the cube example's S
+  if (normals) {
+    json.key("errors").begin_object().key("l2").value(*report.l2_error).key("h1").value(*report.h1_error).end_object();
+    json.key("normal_angle_deg").begin_object().key("max").value(normals->max_deg);
+    json.key("mean").value(normals->mean_deg).end_object();
+  }
+  json.key("norms").begin_object().key("l2").value(report.l2_norm);
+  json.key("h1_seminorm").value(report.h1_seminorm).end_object();
+  json.key("flux").begin_object().key("source").value(report.source).key("outflow").value(report.outflow);
+  json.key("relative_difference").value(relative_flux_difference(report)).end_object();
+  json.key("seconds").begin_object().key("read").value(read_seconds).key("setup").value(report.setup_seconds);
+  json.key("assembly").value(report.assembly_seconds).key("solve").value(report.solve_seconds);
+  json.key("postprocess").value(report.postprocess_seconds).key("total").value(total_seconds).end_object();
+  json.key("ranks").value(ranks).end_object();
+  const std::string text = json.str();
+  meccano::write_file_atomically(path, [&text](std::ostream& out) { out << text; });
+}
 
 void solve(MPI_Comm communicator, const Options& options) {
   const unsigned int degree = options.count("--degree") ? parse_degree(options.at("--degree")) : 1;
@@ -58,18 +99,20 @@ void solve(MPI_Comm communicator, const Options& options) {
   const InterfaceProblem problem = manufactured ? manufactured_problem() : unit_source_problem();
 
   const SolveReport report = solve_interface_problem(communicator, mesh, degree, problem, vtu);
+  const double total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!root) return;
 
   std::vector<TriangleField> fields;
+  std::optional<NormalError> normals;
   std::cout << std::setprecision(4) << "mesh        " << options.at("--mesh") << ": " << report.cells << " tets, h = "
             << report.h << " (longest edge); interface_" << mesh.interface_name << ": " << mesh.interface.size()
             << " triangles, area " << interface_area(mesh) << '\n';
   if (manufactured) {
-    const NormalError normals = cube_example_normal_error(mesh);
-    fields.emplace_back("normal_angle_deg", normals.per_triangle_deg);
+    normals = cube_example_normal_error(mesh);
+    fields.emplace_back("normal_angle_deg", normals->per_triangle_deg);
     std::cout << "surface     the cube example's (nodes within " << match.max_deviation << " of its formula, tolerance "
               << match.tolerance << "): the manufactured solution\n"
-              << "normals     angle to S's normal: max " << normals.max_deg << " deg, mean " << normals.mean_deg
+              << "normals     angle to S's normal: max " << normals->max_deg << " deg, mean " << normals->mean_deg
               << " deg (area-weighted)\n";
   } else {
     std::cout << "surface     not the cube example's (nodes up to " << match.max_deviation << " off its formula, tolerance "
@@ -82,11 +125,10 @@ void solve(MPI_Comm communicator, const Options& options) {
   std::cout << "norms       L2 " << report.l2_norm << ", H1 seminorm " << report.h1_seminorm << '\n'
             << "source      " << report.source << "  (int_Omega f + int_S g_S)\n"
             << "outflow     " << report.outflow << "  (-int_boundary grad u_h . n)\n"
-            << std::setprecision(3) << "balance     relative difference "
-            << std::abs(report.outflow - report.source) / std::abs(report.source) << '\n'
+            << std::setprecision(3) << "balance     relative difference " << relative_flux_difference(report) << '\n'
             << std::fixed << "seconds     read " << read_seconds << ", setup " << report.setup_seconds << ", assembly "
             << report.assembly_seconds << ", solve " << report.solve_seconds << ", evaluation and output "
-            << report.postprocess_seconds << '\n';
+            << report.postprocess_seconds << ", total " << total_seconds << '\n';
 
   if (!vtu.empty()) {
     std::vector<double> source;
@@ -98,11 +140,14 @@ void solve(MPI_Comm communicator, const Options& options) {
     fields.emplace_back("g_S", std::move(source));
     write_interface_vtu(mesh, fields, vtu + "_interface.vtu");
   }
+  if (options.count("--report"))
+    write_report(options.at("--report"), options, mesh, degree, report, normals, read_seconds, total_seconds,
+                 dealii::Utilities::MPI::n_mpi_processes(communicator));
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return run_program(argc, argv, "poisson_interface", usage, solve, {"--mesh", "--interface", "--degree", "--vtu"},
-                     {"--mesh"});
+  return run_program(argc, argv, "poisson_interface", usage, solve,
+                     {"--mesh", "--interface", "--degree", "--vtu", "--report"}, {"--mesh"});
 }

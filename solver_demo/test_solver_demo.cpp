@@ -22,11 +22,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <regex>
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <unistd.h>
@@ -246,15 +248,23 @@ TEST_F(InterfaceMeshTest, BadFilesAreRefusedWithTheirDefect) {
 using Execution = meccano::testing::CommandRun;
 using meccano::testing::run_command;
 
-// The number after `label` at the start of a line of poisson_interface's output.
-double value_after(const std::string& output, const std::string& label) {
+// The number that `prefix` (a regular expression) first comes before in `text`.
+double number_after_pattern(const std::string& text, const std::string& prefix) {
   std::smatch match;
-  if (!std::regex_search(output, match, std::regex("(^|\n)" + label + " +([-+0-9.eE]+)"))) {
-    ADD_FAILURE() << "no '" << label << "' in:\n" << output;
+  if (!std::regex_search(text, match, std::regex(prefix + "([-+0-9.eE]+)"))) {
+    ADD_FAILURE() << "no '" << prefix << "' in:\n" << text;
     return std::nan("");
   }
-  return std::stod(match[2]);
+  return std::stod(match[match.size() - 1]);
 }
+
+// The number after `label` at the start of a line of poisson_interface's output.
+double value_after(const std::string& output, const std::string& label) {
+  return number_after_pattern(output, "(^|\n)" + label + " +");
+}
+
+// The value of the first member `key` in a JSON text.
+double json_number(const std::string& json, const std::string& key) { return number_after_pattern(json, "\"" + key + "\": "); }
 
 std::vector<std::vector<double>> read_csv(const std::string& file, std::string& header) {
   std::ifstream in(file);
@@ -335,6 +345,34 @@ TEST_F(Programs, TwoRanksGiveTheSerialErrors) {
   }
   EXPECT_TRUE(fs::exists(path("mpi.pvtu")));
   EXPECT_TRUE(fs::exists(path("mpi.1.vtu")));
+}
+
+// --report holds the numbers the text prints, at full precision (the text has 12 digits).
+TEST_F(Programs, ReportHoldsThePrintedNumbers) {
+  const meccano::InsertionResult result = insert(triangulate_cube_example(24), 9, 0.1);
+  meccano::write_msh41(result.mesh, meccano::output_groups(result), path("patch.msh"));
+  const Execution solve =
+      run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + path("patch.msh") + " --report " + path("run.json"));
+  ASSERT_EQ(solve.status, 0) << solve.output;
+  std::ifstream file(path("run.json"));
+  const std::string report((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  for (const char* part : {"\"manufactured\": true", "\"interface\": \"interface_patch\"", "\"degree\": 1", "\"ranks\": 1",
+                           "\"errors\"", "\"flux\"", "\"seconds\""})
+    ASSERT_NE(report.find(part), std::string::npos) << part << " missing from\n" << report;
+  std::smatch dofs;
+  ASSERT_TRUE(std::regex_search(solve.output, dofs, std::regex("P1, ([0-9]+) dofs"))) << solve.output;
+  EXPECT_EQ(json_number(report, "dofs"), std::stod(dofs[1]));
+  EXPECT_EQ(json_number(report, "cells"), static_cast<double>(result.mesh.num_tets()));
+  const std::string errors = report.substr(report.find("\"errors\""));
+  const std::string flux = report.substr(report.find("\"flux\""));
+  for (const auto& [json, key, label] : {std::tuple{errors, "l2", "L2 error"}, std::tuple{errors, "h1", "H1 error"},
+                                         std::tuple{flux, "source", "source"}, std::tuple{flux, "outflow", "outflow"}}) {
+    const double printed = value_after(solve.output, label);
+    EXPECT_NEAR(json_number(json, key), printed, 1e-11 * std::abs(printed)) << key;
+  }
+  const std::string seconds = report.substr(report.find("\"seconds\""));
+  EXPECT_GE(json_number(seconds, "total"),
+            json_number(seconds, "setup") + json_number(seconds, "assembly") + json_number(seconds, "solve"));
 }
 
 TEST_F(Programs, BadInputAndUsage) {

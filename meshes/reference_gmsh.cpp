@@ -9,30 +9,19 @@
 // surfaces are embedded in the volume.
 // Exit status: 0 success, 1 failure (bad input data, meshing failed, cannot write), 2 usage error.
 
-#include <meccano/atomic_file.hpp>
-#include <meccano/box.hpp>
+#include "reference_common.hpp"
+
 #include <meccano/error.hpp>
-#include <meccano/json_writer.hpp>
-#include <meccano/quality.hpp>
-#include <meccano/surface.hpp>
-#include <meccano/surface_validation.hpp>
 #include <meccano/tet_mesh.hpp>
 
 #include <gmsh.h>
 
 #include <algorithm>
 #include <array>
-#include <cctype>
-#include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
-#include <iomanip>
-#include <iostream>
 #include <map>
 #include <numbers>
-#include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -70,146 +59,38 @@ Example:
                  --output reference.msh --report reference.json
 )";
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using meccano::reference::UsageError;
 
 enum class Algorithm { hxt, delaunay };
 
 struct Options {
-  meccano::Box box;
-  bool box_given = false;
-  std::vector<std::pair<std::string, std::string>> surfaces;  // file, name
-  std::optional<double> size;
-  std::string output;
+  meccano::reference::CommonOptions common;
   Algorithm algorithm = Algorithm::hxt;
   int threads = 1;
-  std::optional<std::string> report;
-  bool quiet = false;
 };
-
-// FILE[:NAME] exactly as meccano-immerse reads it: a colon followed by a path separator belongs to the
-// file name.
-std::pair<std::string, std::string> parse_surface(const std::string& text, std::size_t position) {
-  const auto colon = text.rfind(':');
-  if (colon != std::string::npos && colon > 0 && text.find('/', colon) == std::string::npos) {
-    const std::string name = text.substr(colon + 1);
-    if (name.empty()) throw UsageError("--surface " + text + ": empty name after ':'");
-    for (char c : name)
-      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-')
-        throw UsageError("--surface " + text + ": a name may hold letters, digits, '_' and '-' only");
-    return {text.substr(0, colon), name};
-  }
-  return {text, std::to_string(position)};
-}
-
-double parse_number(const std::string& option, const std::string& text) {
-  std::size_t used = 0;
-  double value = 0.0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value))
-    throw UsageError(option + ": '" + text + "' is not a finite number");
-  return value;
-}
-
-bool ends_with(const std::string& text, const std::string& suffix) {
-  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 Options parse_options(int argc, char** argv) {
   Options options;
-  std::vector<std::string> args(argv + 1, argv + argc);
-  for (std::size_t i = 0; i < args.size(); ++i) {
+  meccano::reference::parse_arguments(argc, argv, usage_text, options.common,
+                                      [&](const std::vector<std::string>& args, std::size_t& i) {
     const std::string& arg = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw UsageError(arg + " needs a value");
-      return args[++i];
-    };
-    if (arg == "--help" || arg == "-h") {
-      std::cout << usage_text;
-      std::exit(0);
-    } else if (arg == "--box") {
-      // Six separate numbers, or one comma-separated list as meccano-immerse takes it.
-      std::vector<std::string> items;
-      if (const std::string& first = value(); first.find(',') != std::string::npos) {
-        std::stringstream stream(first);
-        for (std::string item; std::getline(stream, item, ',');) items.push_back(item);
-      } else {
-        items.push_back(first);
-        while (items.size() < 6 && i + 1 < args.size() && !args[i + 1].starts_with("--")) items.push_back(args[++i]);
-      }
-      if (items.size() != 6) throw UsageError("--box takes 6 numbers: XMIN YMIN ZMIN XMAX YMAX ZMAX");
-      std::array<double, 6> v{};
-      for (int k = 0; k < 6; ++k) v[k] = parse_number(arg, items[k]);
-      options.box = {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
-      for (int k = 0; k < 3; ++k)
-        if (!(v[k] < v[k + 3])) throw UsageError("--box: every minimum must be below its maximum");
-      options.box_given = true;
-    } else if (arg == "--surface") {
-      options.surfaces.push_back(parse_surface(value(), options.surfaces.size() + 1));
-    } else if (arg == "--size") {
-      options.size = parse_number(arg, value());
-      if (!(*options.size > 0)) throw UsageError("--size must be positive");
-    } else if (arg == "--output" || arg == "-o") {
-      options.output = value();
-    } else if (arg == "--algorithm") {
-      const std::string& name = value();
+    if (arg == "--algorithm") {
+      const std::string& name = meccano::reference::option_value(args, i);
       if (name == "hxt") options.algorithm = Algorithm::hxt;
       else if (name == "delaunay") options.algorithm = Algorithm::delaunay;
       else throw UsageError("--algorithm " + name + ": the algorithms available are: hxt, delaunay");
     } else if (arg == "--threads") {
-      const double threads = parse_number(arg, value());
+      const double threads = meccano::reference::parse_number(arg, meccano::reference::option_value(args, i));
       if (threads != std::floor(threads) || threads < 1 || threads > 1024)
         throw UsageError("--threads takes an integer between 1 and 1024");
       options.threads = static_cast<int>(threads);
-    } else if (arg == "--report") {
-      options.report = value();
-    } else if (arg == "--quiet" || arg == "-q") {
-      options.quiet = true;
     } else {
-      throw UsageError("unknown option '" + arg + "'");
+      return false;
     }
-  }
-  if (!options.box_given) throw UsageError("--box is required");
-  if (options.surfaces.empty()) throw UsageError("--surface is required");
-  if (!options.size) throw UsageError("--size is required");
-  if (options.output.empty()) throw UsageError("--output is required");
-  if (!ends_with(options.output, ".msh")) throw UsageError("--output " + options.output + ": only .msh output is supported");
-  if (options.report && !ends_with(*options.report, ".json"))
-    throw UsageError("--report " + *options.report + ": the report is a .json file");
-  for (std::size_t i = 0; i < options.surfaces.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (options.surfaces[i].second == options.surfaces[j].second)
-        throw UsageError("two surfaces are named " + options.surfaces[i].second);
+    return true;
+  });
   return options;
 }
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-class Progress {
- public:
-  explicit Progress(bool quiet) : quiet_(quiet) {}
-  template <class... Parts>
-  void say(const Parts&... parts) const {
-    if (quiet_) return;
-    std::ostringstream line;
-    line << "[" << std::fixed << std::setprecision(3) << seconds_since(start_) << " s] " << std::defaultfloat;
-    (line << ... << parts);
-    std::cerr << line.str() << std::endl;
-  }
-
- private:
-  bool quiet_;
-  Clock::time_point start_ = Clock::now();
-};
 
 // Gmsh keeps global state: one model per process, finalized on every way out.
 class GmshSession {
@@ -305,20 +186,8 @@ void add_named_group(int dim, const std::vector<int>& entities, const std::strin
   gmsh::model::setPhysicalName(dim, group, name);
 }
 
-struct MeshSummary {
-  std::size_t tets = 0;
-  std::size_t nodes = 0;
-  std::size_t inverted = 0;  // signed volume not positive (or not a number)
-  // Equilateral mean ratio over all tets, an inverted one counting as 0; std is the population's.
-  double min_mean_ratio = 0.0, mean_mean_ratio = 0.0, std_mean_ratio = 0.0;
-  double min_dihedral_deg = 180.0, max_dihedral_deg = 0.0;  // over the tets that are not inverted
-};
-
-// Counts and quality of the tets Gmsh made, by meccano's per-tet quality functions and with the rules
-// of meccano::summarize_quality (inverted tets count as quality 0, dihedral angles of valid tets only,
-// Welford's running mean and variance), so that both tools are measured alike. summarize_quality itself
-// takes a meccano TetMesh, which a Gmsh mesh is not.
-MeshSummary summarize_mesh() {
+// Counts and quality of the tets Gmsh made, measured like every reference's (reference_common.hpp).
+meccano::reference::MeshSummary summarize_mesh() {
   std::vector<std::size_t> node_tags;
   std::vector<double> coordinates, parametric;
   gmsh::model::mesh::getNodes(node_tags, coordinates, parametric);
@@ -330,28 +199,11 @@ MeshSummary summarize_mesh() {
   std::vector<std::size_t> tet_tags, tet_nodes;
   gmsh::model::mesh::getElementsByType(4, tet_tags, tet_nodes);
   if (tet_tags.empty()) throw meccano::MeshingError("Gmsh produced no tetrahedra");
-  MeshSummary summary{.tets = tet_tags.size(), .nodes = node_tags.size(), .min_mean_ratio = 1.0};
-  double squared_deviations = 0.0;
-  for (std::size_t t = 0; t < tet_tags.size(); ++t) {
+  return meccano::reference::summarize_tets(tet_tags.size(), node_tags.size(), [&](std::size_t t) {
     meccano::TetPoints p;
     for (int i = 0; i < 4; ++i) p[i] = point_of_tag[tet_nodes[4 * t + i]];
-    const double volume = meccano::signed_volume(p[0], p[1], p[2], p[3]);
-    const bool valid = volume > 0.0 && std::isfinite(volume);
-    // Clamped because rounding may flip the sign of a nearly flat tet's determinant.
-    const double eta = valid ? std::max(0.0, meccano::mean_ratio_equilateral(p)) : 0.0;
-    summary.inverted += valid ? 0 : 1;
-    summary.min_mean_ratio = std::min(summary.min_mean_ratio, eta);
-    const double delta = eta - summary.mean_mean_ratio;
-    summary.mean_mean_ratio += delta / static_cast<double>(t + 1);
-    squared_deviations += delta * (eta - summary.mean_mean_ratio);
-    if (!valid) continue;
-    for (double angle : meccano::dihedral_angles_deg(p)) {
-      summary.min_dihedral_deg = std::min(summary.min_dihedral_deg, angle);
-      summary.max_dihedral_deg = std::max(summary.max_dihedral_deg, angle);
-    }
-  }
-  summary.std_mean_ratio = std::sqrt(squared_deviations / static_cast<double>(tet_tags.size()));
-  return summary;
+    return p;
+  });
 }
 
 // gmsh::write picks the format from the extension, so the temporary name ends in .msh too; it lives in
@@ -375,45 +227,18 @@ void write_msh_atomically(const std::string& path) {
   }
 }
 
-struct RunRecord {
-  const Options& options;
-  std::vector<std::pair<std::string, std::size_t>> interface_triangles;  // name, count
-  MeshSummary mesh;
-  double meshing_seconds = 0.0;
-};
-
-// Key names follow meccano::QualitySummary, so that the two tools' reports read alike.
-void write_report(const RunRecord& run, double total_seconds, const std::string& path) {
+// Key names follow meccano::QualitySummary, so that the reference tools' reports read alike.
+void write_report(const meccano::reference::ReferenceRun& run, const Options& options, double total_seconds) {
   std::string version;
   gmsh::option::getString("General.Version", version);
-  meccano::JsonWriter json;
-  json.begin_object()
-      .key("tool").value("reference-gmsh")
-      .key("gmsh_version").value(version)
-      .key("algorithm").value(run.options.algorithm == Algorithm::hxt ? "hxt" : "delaunay")
-      .key("threads").value(run.options.threads)
-      .key("size").value(*run.options.size)
-      .key("tets").value(run.mesh.tets)
-      .key("nodes").value(run.mesh.nodes)
-      .key("inverted").value(run.mesh.inverted)
-      .key("interface_triangles").begin_object();
-  for (const auto& [name, count] : run.interface_triangles) json.key(name).value(count);
-  json.end_object()
-      .key("seconds").begin_object()
-      .key("meshing").value(run.meshing_seconds)
-      .key("total").value(total_seconds)
-      .end_object()
-      .key("quality").begin_object()
-      .key("equilateral").begin_object()
-      .key("min").value(run.mesh.min_mean_ratio)
-      .key("mean").value(run.mesh.mean_mean_ratio)
-      .key("std").value(run.mesh.std_mean_ratio)
-      .end_object()
-      .key("min_dihedral_deg").value(run.mesh.min_dihedral_deg)
-      .key("max_dihedral_deg").value(run.mesh.max_dihedral_deg)
-      .end_object()
-      .end_object();
-  meccano::write_file_atomically(path, [&](std::ostream& out) { out << json.str(); });
+  meccano::reference::write_report(
+      run,
+      [&](meccano::JsonWriter& json) {
+        json.key("gmsh_version").value(version)
+            .key("algorithm").value(options.algorithm == Algorithm::hxt ? "hxt" : "delaunay")
+            .key("threads").value(options.threads);
+      },
+      total_seconds, *options.common.report);
 }
 
 // Gmsh cannot split the kept triangles, and when the tets around them must be much smaller HXT leaves
@@ -430,30 +255,24 @@ double mean_edge_length(const meccano::TriangleSurface& surface) {
 }
 
 int run(const Options& options) {
+  using meccano::reference::Clock;
   const auto start = Clock::now();
-  const Progress progress(options.quiet);
-  // Read and validate every surface before Gmsh starts: the same inputs as meccano-immerse, with the
-  // same messages.
-  std::vector<meccano::TriangleSurface> surfaces;
-  for (const auto& [file, name] : options.surfaces) {
-    surfaces.push_back(meccano::read_surface(file));
-    surfaces.back().name = name;
-    progress.say("surface ", name, ": ", file, ", ", surfaces.back().triangles.size(), " triangles, ",
-                 surfaces.back().points.size(), " points");
-  }
-  meccano::validate_surfaces(surfaces, options.box);
-  progress.say("surfaces valid: open disks, inside the box, disjoint");
+  const meccano::reference::CommonOptions& common = options.common;
+  const meccano::reference::Progress progress(common.quiet);
+  // Every surface is read and validated before Gmsh starts: the same inputs as meccano-immerse, with
+  // the same messages.
+  const std::vector<meccano::TriangleSurface> surfaces = meccano::reference::read_valid_surfaces(common, progress);
   for (const auto& surface : surfaces)
-    if (const double edge = mean_edge_length(surface); *options.size < finest_size_for_kept_triangles * edge)
-      progress.say("warning: --size ", *options.size, " is below ", finest_size_for_kept_triangles,
+    if (const double edge = mean_edge_length(surface); *common.size < finest_size_for_kept_triangles * edge)
+      progress.say("warning: --size ", *common.size, " is below ", finest_size_for_kept_triangles,
                    " x the mean edge length ", edge, " of surface ", surface.name,
                    ": next to its kept triangles Gmsh leaves nearly flat tets");
 
   const GmshSession session;
-  gmsh::option::setNumber("General.Terminal", options.quiet ? 0 : 1);
+  gmsh::option::setNumber("General.Terminal", common.quiet ? 0 : 1);
   gmsh::option::setNumber("General.Verbosity", 2);  // errors and warnings; progress is ours
   gmsh::option::setNumber("General.NumThreads", options.threads);
-  gmsh::option::setNumber("Mesh.MeshSizeMax", *options.size);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", *common.size);
   gmsh::option::setNumber("Mesh.Algorithm3D", options.algorithm == Algorithm::hxt ? 10 : 1);
   gmsh::option::setNumber("Mesh.Optimize", 1);
   gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
@@ -461,7 +280,7 @@ int run(const Options& options) {
 
   gmsh::model::add("reference");
   const std::vector<int> surface_entities = add_surfaces(surfaces);
-  const BoxEntities box = add_box(options.box, *options.size);
+  const BoxEntities box = add_box(common.box, *common.size);
   gmsh::model::geo::synchronize();
   gmsh::model::mesh::embed(2, surface_entities, 3, box.volume);
 
@@ -472,10 +291,10 @@ int run(const Options& options) {
     add_named_group(2, {surface_entities[s]}, "interface_" + surfaces[s].name);
 
   progress.say("gmsh: meshing with ", options.algorithm == Algorithm::hxt ? "HXT" : "Delaunay", ", size ",
-               *options.size, ", ", options.threads, " thread(s)");
+               *common.size, ", ", options.threads, " thread(s)");
   const auto meshing_start = Clock::now();
   gmsh::model::mesh::generate(3);
-  const double meshing_seconds = seconds_since(meshing_start);
+  const double meshing_seconds = meccano::reference::seconds_since(meshing_start);
 
   // The reference promises S as given: 3D boundary recovery must not have split any input triangle.
   std::vector<std::pair<std::string, std::size_t>> interface_triangles;
@@ -488,16 +307,15 @@ int run(const Options& options) {
                                   std::to_string(element_tags.size()) + " meshed)");
     interface_triangles.emplace_back(surfaces[s].name, element_tags.size());
   }
-  const RunRecord record{options, std::move(interface_triangles), summarize_mesh(), meshing_seconds};
-  progress.say("gmsh: ", record.mesh.tets, " tets, ", record.mesh.nodes, " nodes in ", record.meshing_seconds,
-               " s; mean ratio min ", record.mesh.min_mean_ratio, " mean ", record.mesh.mean_mean_ratio,
-               ", dihedral ", record.mesh.min_dihedral_deg, "..", record.mesh.max_dihedral_deg, " deg");
+  const meccano::reference::ReferenceRun record{"reference-gmsh", *common.size, std::move(interface_triangles),
+                                               summarize_mesh(), meshing_seconds};
+  progress.say("gmsh: ", meccano::reference::describe(record.mesh), " in ", record.meshing_seconds, " s");
 
-  write_msh_atomically(options.output);
-  progress.say("wrote ", options.output);
-  if (options.report) {
-    write_report(record, seconds_since(start), *options.report);
-    progress.say("wrote ", *options.report);
+  write_msh_atomically(common.output);
+  progress.say("wrote ", common.output);
+  if (common.report) {
+    write_report(record, options, meccano::reference::seconds_since(start));
+    progress.say("wrote ", *common.report);
   }
   return 0;
 }
@@ -505,16 +323,11 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(parse_options(argc, argv));
-  } catch (const UsageError& error) {
-    std::cerr << "reference-gmsh: " << error.what() << "\n(see reference-gmsh --help)\n";
-    return 2;
-  } catch (const std::exception& error) {
-    std::cerr << "reference-gmsh: error: " << error.what() << '\n';
-    return 1;
-  } catch (const std::string& gmsh_error) {  // the Gmsh 4.8 API throws its error messages as strings
-    std::cerr << "reference-gmsh: error: gmsh: " << gmsh_error << '\n';
-    return 1;
-  }
+  return meccano::reference::run_tool("reference-gmsh", [&] {
+    try {
+      return run(parse_options(argc, argv));
+    } catch (const std::string& gmsh_error) {  // the Gmsh 4.8 API throws its error messages as strings
+      throw meccano::MeshingError("gmsh: " + gmsh_error);
+    }
+  });
 }

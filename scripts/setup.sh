@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev                       # the module's only library dependency (with OpenMP)
   libgtest-dev libbenchmark-dev       # tests and benchmarks
   libgmsh-dev gmsh                    # independent MSH reader in the tests, reference meshes
+  libtet1.5-dev tetgen                # the TetGen reference mesher (meshes/reference-tetgen)
   libdeal.ii-dev                      # the demo solver (solver_demo/): deal.II with Trilinos and MPI
   python3 python3-matplotlib python3-numpy   # plots in doc/
   clang libclang-rt-14-dev libomp-dev  # libFuzzer targets (tests/fuzz/): clang's sanitizers, libFuzzer, OpenMP

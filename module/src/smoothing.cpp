@@ -195,7 +195,8 @@ class Smoother {
   std::vector<TetId> active_tets_;
   SmoothingStats stats_;
   bool tangled_ = true;               // did the last sweep end with inverted tets (or none ran yet)?
-  double untangling_epsilon_ = 1e-3;  // ε / mean|σ|, raised while untangling stalls
+  static constexpr double initial_untangling_epsilon = 1e-3;
+  double untangling_epsilon_ = initial_untangling_epsilon;  // ε / mean|σ|, raised while untangling stalls
 };
 
 void Smoother::classify_nodes() {
@@ -568,6 +569,8 @@ SmoothingStats Smoother::run() {
       }
       continue;
     }
+    // A raised ε would keep δ large on valid stars, and their barrier soft: smoothing could tangle again.
+    untangling_epsilon_ = initial_untangling_epsilon;
     if (clean_sweeps++ == 0 && stats_.inverted_before > 0) stats_.untangling_sweeps = sweep;
     if (clean_sweeps >= options_.smoothing_sweeps || optimised == 0) break;
     if (comparable && previous_objective - record.objective <= options_.tolerance * previous_objective) break;

@@ -12,21 +12,6 @@
 namespace meccano::reference {
 namespace {
 
-// FILE[:NAME] exactly as meccano-immerse reads it: a colon followed by a path separator belongs to the
-// file name.
-std::pair<std::string, std::string> parse_surface(const std::string& text, std::size_t position) {
-  const auto colon = text.rfind(':');
-  if (colon != std::string::npos && colon > 0 && text.find('/', colon) == std::string::npos) {
-    const std::string name = text.substr(colon + 1);
-    if (name.empty()) throw UsageError("--surface " + text + ": empty name after ':'");
-    for (char c : name)
-      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-')
-        throw UsageError("--surface " + text + ": a name may hold letters, digits, '_' and '-' only");
-    return {text.substr(0, colon), name};
-  }
-  return {text, std::to_string(position)};
-}
-
 // Six separate numbers, or one comma-separated list as meccano-immerse takes it.
 Box parse_box(const std::vector<std::string>& args, std::size_t& i) {
   const std::string& option = args[i];
@@ -58,7 +43,7 @@ bool parse_common_option(const std::vector<std::string>& args, std::size_t& i, C
     options.box = parse_box(args, i);
     options.box_given = true;
   } else if (arg == "--surface") {
-    options.surfaces.push_back(parse_surface(option_value(args, i), options.surfaces.size() + 1));
+    options.surfaces.push_back(tools::parse_surface_argument<UsageError>(option_value(args, i), options.surfaces.size() + 1));
   } else if (arg == "--size") {
     options.size = parse_number(arg, option_value(args, i));
     if (!(*options.size > 0)) throw UsageError("--size must be positive");

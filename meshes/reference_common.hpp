@@ -21,6 +21,8 @@
 #include <meccano/quality.hpp>
 #include <meccano/surface.hpp>
 
+#include "tool_support.hpp"
+
 #include <chrono>
 #include <cstddef>
 #include <functional>
@@ -70,23 +72,7 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start);
 
-// Progress lines on stderr, each stamped with the seconds since the tool started; nothing when quiet.
-class Progress {
- public:
-  explicit Progress(bool quiet) : quiet_(quiet) {}
-  template <class... Parts>
-  void say(const Parts&... parts) const {
-    if (quiet_) return;
-    std::ostringstream line;
-    line << "[" << std::fixed << std::setprecision(3) << seconds_since(start_) << " s] " << std::defaultfloat;
-    (line << ... << parts);
-    std::cerr << line.str() << std::endl;
-  }
-
- private:
-  bool quiet_;
-  Clock::time_point start_ = Clock::now();
-};
+using tools::Progress;
 
 // The surfaces of the options, named, in order, validated against the box.
 std::vector<TriangleSurface> read_valid_surfaces(const CommonOptions& options, const Progress& progress);

@@ -12,6 +12,8 @@
 #include <meccano/surface.hpp>
 #include <meccano/surface_validation.hpp>
 
+#include "tool_support.hpp"
+
 #include <array>
 #include <cctype>
 #include <chrono>
@@ -164,18 +166,8 @@ struct Options {
   bool quiet = false;
 };
 
-// FILE[:NAME]; a colon followed by a path separator belongs to the file name.
 std::pair<std::string, std::string> parse_surface(const std::string& text, std::size_t position) {
-  const auto colon = text.rfind(':');
-  if (colon != std::string::npos && colon > 0 && text.find('/', colon) == std::string::npos) {
-    const std::string name = text.substr(colon + 1);
-    if (name.empty()) throw UsageError("--surface " + text + ": empty name after ':'");
-    for (char c : name)
-      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-')
-        throw UsageError("--surface " + text + ": a name may hold letters, digits, '_' and '-' only");
-    return {text.substr(0, colon), name};
-  }
-  return {text, std::to_string(position)};
+  return meccano::tools::parse_surface_argument<UsageError>(text, position);
 }
 
 std::vector<double> parse_numbers(const std::string& option, const std::string& text, std::size_t count) {
@@ -320,24 +312,7 @@ Options parse_options(int argc, char** argv) {
   return options;
 }
 
-class Progress {
- public:
-  explicit Progress(bool quiet) : quiet_(quiet) {}
-  template <class... Parts>
-  void say(const Parts&... parts) const {
-    if (quiet_) return;
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    std::ostringstream line;
-    line.precision(3);
-    line << "[" << std::fixed << seconds << " s] ";
-    (line << ... << parts);
-    std::cerr << line.str() << std::endl;
-  }
-
- private:
-  bool quiet_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-};
+using meccano::tools::Progress;
 
 int run(const Options& options) {
   const Progress progress(options.quiet);

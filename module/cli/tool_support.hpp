@@ -1,0 +1,51 @@
+// What the project's command-line tools share (meccano-immerse, and reference-gmsh and reference-tetgen
+// in meshes/): the FILE[:NAME] surface argument and timestamped progress lines. Header-only; not part
+// of the installed library.
+#pragma once
+
+#include <cctype>
+#include <chrono>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <utility>
+
+namespace meccano::tools {
+
+// FILE[:NAME] as (file, name), NAME defaulting to the surface's 1-based position. A colon followed by a
+// path separator belongs to the file name. A bad name throws Error (the tool's usage error) with why.
+template <class Error>
+std::pair<std::string, std::string> parse_surface_argument(const std::string& text, std::size_t position) {
+  const auto colon = text.rfind(':');
+  if (colon != std::string::npos && colon > 0 && text.find('/', colon) == std::string::npos) {
+    const std::string name = text.substr(colon + 1);
+    if (name.empty()) throw Error("--surface " + text + ": empty name after ':'");
+    for (char c : name)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-')
+        throw Error("--surface " + text + ": a name may hold letters, digits, '_' and '-' only");
+    return {text.substr(0, colon), name};
+  }
+  return {text, std::to_string(position)};
+}
+
+// Progress lines on stderr, each stamped with the seconds since the tool started; nothing when quiet.
+class Progress {
+ public:
+  explicit Progress(bool quiet) : quiet_(quiet) {}
+  template <class... Parts>
+  void say(const Parts&... parts) const {
+    if (quiet_) return;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    std::ostringstream line;
+    line.precision(3);
+    line << "[" << std::fixed << seconds << " s] " << std::defaultfloat;
+    (line << ... << parts);
+    std::cerr << line.str() << std::endl;
+  }
+
+ private:
+  bool quiet_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace meccano::tools

@@ -78,36 +78,45 @@ TEST_P(SurfaceApproximationOn, IsAHealedDiskCloseToSAndOrientedLikeIt) {
 INSTANTIATE_TEST_SUITE_P(AllSurfacesAndBoxes, SurfaceApproximationOn, ::testing::ValuesIn(testing::surface_cases(16, true)),
                          [](const ::testing::TestParamInfo<Case>& param) { return param.param.name; });
 
-TEST(SurfaceApproximation, HealingStatisticsCountTheRules) {
+// Steps 1 and 2 for one surface in the unit cube's meccano.
+struct Healed {
   TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
-  const TriangleSurface surface = testing::saddle(24);
+  TetRegion region;
+  HealingStats stats;
+  SurfaceApproximationCheck check;
+};
+
+Healed heal_in_unit_cube(const TriangleSurface& surface, double resolution) {
+  Healed healed;
   const TriangleBVH tree(surface);
   VolumetricStats volumetric_stats;
-  TetRegion region = approximate_volume(mesh, tree, {1.0 / 32}, volumetric_stats);
-  const HealingStats stats = approximate_surface(mesh, region, surface, tree, 0);
+  healed.region = approximate_volume(healed.mesh, tree, {resolution}, volumetric_stats);
+  healed.stats = approximate_surface(healed.mesh, healed.region, surface, tree, 0);
+  healed.check = check_surface_approximation(healed.mesh, healed.region, 0);
+  return healed;
+}
+
+TEST(SurfaceApproximation, HealingStatisticsCountTheRules) {
+  const Healed healed = heal_in_unit_cube(testing::saddle(24), 1.0 / 32);
   // The saddle needs every kind of repair; the counts must reflect work actually done.
+  const HealingStats& stats = healed.stats;
   EXPECT_GT(stats.initial_faces, 0);
   EXPECT_GT(stats.extension_faces, 0);
   EXPECT_GT(stats.tets_with_two_faces, 0);
   EXPECT_GT(stats.triangles_with_two_rim_edges, 0);
   EXPECT_GT(stats.dividing_edges, 0);
   EXPECT_GT(stats.passes, 1);
-  EXPECT_EQ(stats.faces, check_surface_approximation(mesh, region, 0).faces);
+  EXPECT_EQ(stats.faces, healed.check.faces);
 }
 
 // Filling a reflex rim corner made corbels here whose removal brought the corner back: healing cycled
 // (fill, remove corbels) until its pass limit. Each corner is now filled once at most.
 TEST(SurfaceApproximation, ReflexCornersAreFilledOnceSoHealingEnds) {
-  const TriangleSurface surface = read_surface(std::string(MECCANO_TEST_DATA_DIR) + "/disk_fill_corbel_cycle.obj");
-  TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
-  const TriangleBVH tree(surface);
-  VolumetricStats volumetric_stats;
-  TetRegion region = approximate_volume(mesh, tree, {0.031441647624062763}, volumetric_stats);
-  const HealingStats stats = approximate_surface(mesh, region, surface, tree, 0);
-  EXPECT_GT(stats.reflex_corners_filled, 0);
-  const SurfaceApproximationCheck check = check_surface_approximation(mesh, region, 0);
-  EXPECT_TRUE(check.healed()) << check.describe();
-  EXPECT_TRUE(check.is_disk()) << check.describe();
+  const Healed healed = heal_in_unit_cube(
+      read_surface(std::string(MECCANO_TEST_DATA_DIR) + "/disk_fill_corbel_cycle.obj"), 0.031441647624062763);
+  EXPECT_GT(healed.stats.reflex_corners_filled, 0);
+  EXPECT_TRUE(healed.check.healed()) << healed.check.describe();
+  EXPECT_TRUE(healed.check.is_disk()) << healed.check.describe();
 }
 
 TEST(SurfaceApproximation, CheckDetectsUnhealedConfigurations) {
@@ -137,18 +146,12 @@ TEST(SurfaceApproximation, CheckDetectsUnhealedConfigurations) {
 TEST(SurfaceApproximation, EdgesToTheBoxAreSplitWhenTheSurfaceIsCloseToIt) {
   // A plane 0.01 above the floor with tets of 1/4: S_M (on the side away from the floor) gets edges to
   // floor nodes, which healing splits.
-  const TriangleSurface plane =
-      testing::graph_patch([](double, double) { return 0.01; }, {0.2, 0.8}, {0.2, 0.8}, 4);
-  TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
-  const TriangleBVH tree(plane);
-  VolumetricStats volumetric_stats;
-  TetRegion region = approximate_volume(mesh, tree, {0.25}, volumetric_stats);
-  const HealingStats stats = approximate_surface(mesh, region, plane, tree, 0);
-  EXPECT_GT(stats.cross_surface_edges, 0);
-  const SurfaceApproximationCheck check = check_surface_approximation(mesh, region, 0);
-  EXPECT_TRUE(check.healed()) << check.describe();
-  EXPECT_EQ(check.nodes_on_box_or_other_surface, 0);
-  EXPECT_TRUE(verify_mesh(mesh).ok());
+  const Healed healed =
+      heal_in_unit_cube(testing::graph_patch([](double, double) { return 0.01; }, {0.2, 0.8}, {0.2, 0.8}, 4), 0.25);
+  EXPECT_GT(healed.stats.cross_surface_edges, 0);
+  EXPECT_TRUE(healed.check.healed()) << healed.check.describe();
+  EXPECT_EQ(healed.check.nodes_on_box_or_other_surface, 0);
+  EXPECT_TRUE(verify_mesh(healed.mesh).ok());
 }
 
 TEST(SurfaceApproximation, SurfaceSqueezedBetweenBoxSidesFailsClearly) {

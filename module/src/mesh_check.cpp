@@ -2,6 +2,8 @@
 
 #include <meccano/quality.hpp>
 
+#include "compensated_sum.hpp"
+
 #include <cmath>
 #include <sstream>
 
@@ -55,7 +57,7 @@ class Checker {
       if (options_.physical) {
         const auto o = mesh_.oriented_tet(t);
         const double volume = signed_volume(mesh_.points[o[0]], mesh_.points[o[1]], mesh_.points[o[2]], mesh_.points[o[3]]);
-        report_.physical_volume += volume;
+        physical_volume_.add(volume);
         if (!(volume > 0.0)) {
           ++report_.inverted_physical;
           problem("tet ", t, " is inverted or flat in physical space (volume ", volume, ")");
@@ -144,6 +146,7 @@ class Checker {
     const int128 expected = int128{6} * cells[0] * cells[1] * cells[2] * grid_cell * grid_cell * grid_cell;
     if (six_volumes != expected) problem("computational volume differs from the box volume");
     if (options_.physical) {
+      report_.physical_volume = physical_volume_.value();
       const Eigen::Vector3d extent = mesh_.meccano.box.extent();
       const double box_volume = extent.prod();
       if (std::abs(report_.physical_volume - box_volume) > 1e-10 * box_volume)
@@ -154,6 +157,7 @@ class Checker {
   const TetMesh& mesh_;
   const MeshCheckOptions& options_;
   MeshCheckReport report_;
+  CompensatedSum physical_volume_;
 };
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <meccano/json_writer.hpp>
 #include <meccano/quality.hpp>
 
+#include "compensated_sum.hpp"
 #include "topology_helpers.hpp"
 
 #include <Eigen/Geometry>
@@ -15,20 +16,6 @@ namespace meccano {
 namespace {
 
 using Face = std::array<int, 3>;  // vertex indices
-
-// Neumaier's compensated sum: millions of tet volumes add up to the box volume to round-off.
-class CompensatedSum {
- public:
-  void add(double x) {
-    const double t = sum_ + x;
-    compensation_ += std::abs(sum_) >= std::abs(x) ? (sum_ - t) + x : (x - t) + sum_;
-    sum_ = t;
-  }
-  double value() const { return sum_ + compensation_; }
-
- private:
-  double sum_ = 0.0, compensation_ = 0.0;
-};
 
 CheckResult named(std::string name) {
   CheckResult check;

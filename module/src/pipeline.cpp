@@ -168,8 +168,7 @@ std::vector<SideRule> other_side_rules(const InsertionResult& result, std::span<
   std::vector<SideRule> retry(rules.begin(), rules.end());
   bool changed = false;
   for (TetId t = 0; t < mesh.num_tets(); ++t) {
-    const auto p = oriented_points(mesh, t);
-    if (signed_volume(p[0], p[1], p[2], p[3]) > 0.0) continue;
+    if (!is_inverted(mesh, t)) continue;
     for (VertexId v : mesh.tets[t]) {
       const int s = surface_of[v];
       if (s < 0 || retry[s] != rules[s]) continue;

@@ -75,10 +75,7 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
   }
   stats.nodes = count;
   stats.rim_nodes = static_cast<std::int64_t>(own.rim.size());
-  for (TetId t = 0; t < mesh.num_tets(); ++t) {
-    const auto p = oriented_points(mesh, t);
-    stats.inverted_tets += signed_volume(p[0], p[1], p[2], p[3]) <= 0.0;
-  }
+  stats.inverted_tets = count_inverted(mesh);
   return result;
 }
 

@@ -172,6 +172,17 @@ TetPoints oriented_points(const TetMesh& mesh, TetId t) {
   return {mesh.points[v[0]], mesh.points[v[1]], mesh.points[v[2]], mesh.points[v[3]]};
 }
 
+bool is_inverted(const TetMesh& mesh, TetId t) {
+  const auto p = oriented_points(mesh, t);
+  return signed_volume(p[0], p[1], p[2], p[3]) <= 0.0;
+}
+
+std::int64_t count_inverted(const TetMesh& mesh) {
+  std::int64_t inverted = 0;
+  for (TetId t = 0; t < mesh.num_tets(); ++t) inverted += is_inverted(mesh, t);
+  return inverted;
+}
+
 TetPoints oriented_computational_points(const TetMesh& mesh, TetId t) {
   const auto v = mesh.oriented_tet(t);
   const MeccanoGrid& m = mesh.meccano;

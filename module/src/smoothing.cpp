@@ -23,15 +23,6 @@ using Jacobian = Matrix3d;
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
-std::int64_t count_inverted(const TetMesh& mesh) {
-  std::int64_t inverted = 0;
-  for (TetId t = 0; t < mesh.num_tets(); ++t) {
-    const auto p = oriented_points(mesh, t);
-    inverted += signed_volume(p[0], p[1], p[2], p[3]) <= 0.0;
-  }
-  return inverted;
-}
-
 // ---------------------------------------------------------------------------------------------------
 // The distortion of one tet as a function of one of its vertices.
 //

@@ -39,6 +39,10 @@ std::array<double, 6> dihedral_angles_deg(const TetPoints& p);
 TetPoints oriented_points(const TetMesh& mesh, TetId t);
 TetPoints oriented_computational_points(const TetMesh& mesh, TetId t);
 
+// A tet is inverted when its physical volume, in its positive orientation, is not positive (flat counts).
+bool is_inverted(const TetMesh& mesh, TetId t);
+std::int64_t count_inverted(const TetMesh& mesh);
+
 struct QualityStatistics {
   double min = 0, mean = 0, std = 0;  // over all tets; std is the population standard deviation
 };

@@ -354,6 +354,18 @@ TEST_F(CliTest, AFailedWriteRemovesTheFilesTheRunWrote) {
   EXPECT_TRUE(only_inputs_in_directory(0));
 }
 
+TEST_F(CliTest, AFailedWriteLeavesAFileThatWasThereAsItWas) {
+  const std::string earlier = path("a.msh");
+  std::ofstream(earlier) << "an earlier result\n";
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --level 1 --output " + earlier + " --output /nonexistent-dir/out.mesh");
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_NE(run.output.find("cannot write /nonexistent-dir/out.mesh: "), std::string::npos) << run.output;
+  std::ifstream in(earlier);
+  const std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(content, "an earlier result\n");
+  EXPECT_TRUE(only_inputs_in_directory(1));
+}
+
 TEST_F(CliTest, UnwritableOutputFailsWithStatusOne) {
   const CliRun run = run_cli("--box 0,0,0,1,1,1 --level 1 --output /nonexistent-dir/out.msh");
   EXPECT_EQ(run.status, 1) << run.output;

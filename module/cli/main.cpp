@@ -20,7 +20,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -349,37 +348,28 @@ int run(const Options& options) {
   const auto check = meccano::verify_mesh(result.mesh, {.physical = insertion.last_stage != meccano::Stage::projection});
   if (!check.ok()) throw meccano::MeshingError("the mesh fails its invariant checks: " + check.summary());
 
-  // Each file is written atomically; should a later one fail, the earlier ones are removed, so that a
-  // failed run leaves no file.
-  std::vector<std::string> written;
-  try {
-    const auto groups = meccano::output_groups(result, insertion.last_stage);
-    for (const auto& output : options.outputs) {
-      meccano::write_mesh(result.mesh, groups, output.path, output.format);
-      written.push_back(output.path);
-      progress.say("wrote ", output.path, ": ", result.mesh.num_tets(), " tets, ", result.mesh.num_vertices(),
-                   " nodes");
-    }
-    if (options.histograms) {
-      const std::pair<std::string, const meccano::QualitySummary*> labelled[] = {
-          {"before_smoothing", &result.quality_before_smoothing}, {"after_smoothing", &result.quality_after_smoothing}};
-      meccano::write_quality_histograms_csv(*options.histograms, labelled);
-      written.push_back(*options.histograms);
-      progress.say("wrote ", *options.histograms);
-    }
-    if (options.report) {
-      const std::string report = meccano::insertion_report_json(result, insertion.last_stage);
-      meccano::write_file_atomically(*options.report, [&report](std::ostream& out) { out << report; });
-      written.push_back(*options.report);
-      progress.say("wrote ", *options.report);
-    }
-  } catch (...) {
-    for (const auto& file : written) {
-      std::error_code ignored;
-      std::filesystem::remove(file, ignored);
-    }
-    throw;
+  // The files appear together once all are written: a failed run leaves none, and leaves a file that
+  // was already there as it was.
+  meccano::StagedFiles files;
+  const auto groups = meccano::output_groups(result, insertion.last_stage);
+  for (const auto& output : options.outputs)
+    files.write(output.path, [&](const std::string& path) { meccano::write_mesh(result.mesh, groups, path, output.format); });
+  if (options.histograms) {
+    const std::pair<std::string, const meccano::QualitySummary*> labelled[] = {
+        {"before_smoothing", &result.quality_before_smoothing}, {"after_smoothing", &result.quality_after_smoothing}};
+    files.write(*options.histograms, [&](const std::string& path) { meccano::write_quality_histograms_csv(path, labelled); });
   }
+  if (options.report) {
+    const std::string report = meccano::insertion_report_json(result, insertion.last_stage);
+    files.write(*options.report, [&](const std::string& path) {
+      meccano::write_file_atomically(path, [&report](std::ostream& out) { out << report; });
+    });
+  }
+  files.commit();
+  for (const auto& output : options.outputs)
+    progress.say("wrote ", output.path, ": ", result.mesh.num_tets(), " tets, ", result.mesh.num_vertices(), " nodes");
+  if (options.histograms) progress.say("wrote ", *options.histograms);
+  if (options.report) progress.say("wrote ", *options.report);
   return 0;
 }
 

@@ -13,16 +13,34 @@
 
 namespace meccano {
 
-void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  // Renaming over a device or a FIFO (as root, /dev/full or /dev/null) would replace it: refuse.
+namespace fs = std::filesystem;
+
+namespace {
+
+// Renaming over a device or a FIFO (as root, /dev/full or /dev/null) would replace it: refuse.
+void require_regular_or_absent(const std::string& path) {
   std::error_code status_error;
-  const fs::file_status status = fs::status(target, status_error);
+  const fs::file_status status = fs::status(fs::path(path), status_error);
   if (fs::exists(status) && !fs::is_regular_file(status))
     throw InputError("cannot write " + path + ": not a regular file");
-  fs::path temporary = target;
+}
+
+// A path next to `target` that no other process or call picks, with the same extension (writers such
+// as write_mesh choose the format by it): a.msh -> a.tmp<pid>-<random>.msh.
+fs::path temporary_beside(const std::string& target) {
+  const fs::path path(target);
+  fs::path temporary = path.parent_path() / path.stem();
   temporary += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(std::random_device{}());
+  temporary += path.extension();
+  return temporary;
+}
+
+}  // namespace
+
+void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  require_regular_or_absent(path);
+  const fs::path target(path);
+  const fs::path temporary = temporary_beside(path);
   auto fail = [&](const std::string& reason) {
     std::error_code ignored;
     fs::remove(temporary, ignored);
@@ -50,6 +68,37 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   std::error_code error;
   fs::rename(temporary, target, error);
   if (error) fail(error.message());
+}
+
+StagedFiles::~StagedFiles() {
+  for (const auto& [staged, target] : staged_) {
+    std::error_code ignored;
+    fs::remove(staged, ignored);
+  }
+}
+
+void StagedFiles::write(const std::string& target, const std::function<void(const std::string& path)>& writer) {
+  require_regular_or_absent(target);
+  const std::string staged = temporary_beside(target).string();
+  staged_.emplace_back(staged, target);
+  try {
+    writer(staged);
+  } catch (const InputError& error) {
+    std::string message = error.what();
+    for (auto at = message.find(staged); at != std::string::npos; at = message.find(staged, at + target.size()))
+      message.replace(at, staged.size(), target);
+    throw InputError(message);
+  }
+}
+
+void StagedFiles::commit() {
+  while (!staged_.empty()) {
+    const auto [staged, target] = staged_.front();
+    std::error_code error;
+    fs::rename(staged, target, error);
+    if (error) throw InputError("cannot write " + target + ": " + error.message());  // the rest go with *this
+    staged_.erase(staged_.begin());
+  }
 }
 
 }  // namespace meccano

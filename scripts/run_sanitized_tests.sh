@@ -2,7 +2,11 @@
 # Builds the library and the tests with AddressSanitizer + UndefinedBehaviorSanitizer
 # (MECCANO_SANITIZE, -O1 -g) and runs a representative subset of the suite, which must be clean.
 #
-# Usage: scripts/run_sanitized_tests.sh [build-dir]   (default /tmp/build-asan)
+# Usage: scripts/run_sanitized_tests.sh [--quick] [build-dir]   (default /tmp/build-asan)
+#
+# --quick (CI, scripts/run_tests.sh) also leaves out the tests that take 30 s or more under the
+# sanitizers (doc/robustness.md lists them): one SUS stage case (near_vertical) stays, the full CLI
+# pipeline goes; about 3 minutes of tests instead of 13 on 2 cores.
 #
 # The subset covers every stage on coarse cases: the readers, validation, geometry, bisection, V_M,
 # S_M, parameterization, projection, smoothing, the writers and the CLI. Left out: the long smoothing
@@ -11,6 +15,8 @@
 # library that is not instrumented).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+quick=false
+if [ "${1:-}" = "--quick" ]; then quick=true; shift; fi
 build=${1:-/tmp/build-asan}
 jobs=$(( $(nproc) < 2 ? $(nproc) : 2 ))
 
@@ -32,4 +38,10 @@ unit+='|BallCheck|GrowIntoBall|VolumetricApproximation|SurfaceApproximation\.|Pa
 unit+='|Distortion|QualitySummary|DihedralAngles|HistogramCsv|JsonWriter|MeshIo|SurfaceInterfaces|CliTest'
 unit+='|Smoothing\.(UntanglesAScrambled|UntanglesTowardsTheEquilateral)'
 coarse='(VolumetricOnSurface|SurfaceApproximationOn|ProjectionOn|SmoothingOn)\..*unit_cube_lr16$'
-ctest --test-dir "$build" -j"$jobs" --output-on-failure -R "^(${unit})|${coarse}" -E 'ReferenceGmsh'
+excluded='ReferenceGmsh'
+if $quick; then
+  excluded+='|CliTest\.(FullPipeline|WritesEveryFormat)|SurfaceInterfaces\.(TwoStacked|TheNegativeSide)'
+  excluded+='|Projection\.HausdorffDistanceShrinks|PerturbedSurfacesGiveBallsToo|Smoothing\.UntanglesTowardsTheEquilateral'
+  excluded+='|Geometry\.TriangleTetrahedronNeverMisses|SmoothingOn\..*/(spherical_cap|saddle|stacked_pair|tilted_plane|strongly_curved_sheet|paper_like|perturbed_paper_like)_'
+fi
+ctest --test-dir "$build" -j"$jobs" --output-on-failure -R "^(${unit})|${coarse}" -E "$excluded"

@@ -6,12 +6,15 @@
 // Recipe ("keep", shared/notes/peers.md §2.2): each surface becomes a discrete Gmsh surface;
 // classifySurfaces creates its rim curve without reparametrizing it, so Gmsh never remeshes it; the box
 // is a built-in (geo) volume built *after* the classification, which clears built-in entities; the
-// surfaces are embedded in the volume.
+// surfaces are embedded in the volume. With --size-near-surface, a mesh size growing with the distance to
+// the surfaces (Gmsh's Threshold law) grades the tets from that size at the surfaces to --size, as
+// meccano-immerse's grade towards l_r.
 // Exit status: 0 success, 1 failure (bad input data, meshing failed, cannot write), 2 usage error.
 
 #include "reference_common.hpp"
 
 #include <meccano/error.hpp>
+#include <meccano/geometry.hpp>
 #include <meccano/tet_mesh.hpp>
 
 #include <gmsh.h>
@@ -21,7 +24,10 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <limits>
+#include <memory>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,12 +50,20 @@ Options:
   --size H                 mesh size on the box (required); near a surface the tets follow the size
                            of its triangles, which Gmsh cannot split: below 0.7 x their mean edge
                            length it leaves nearly flat tets against them (a warning says so)
+  --size-near-surface H0   a graded mesh: size H0 at the surfaces, growing linearly with the distance
+                           to them up to H at --size-distance (Gmsh's Threshold law on the distance
+                           to the surfaces' triangles); 0 < H0 <= H. Give the surfaces triangles of
+                           about H0 (they are kept, so the same limit of 0.7 applies to H0). Gmsh
+                           follows the size loosely, HXT more loosely than Delaunay
+  --size-distance D        the distance from the surfaces at which the size reaches H (D > 0; only
+                           with --size-near-surface, and required by it)
   --output FILE.msh        Gmsh MSH 4.1 ASCII with the 3D group `domain`, the 2D groups xmin, xmax,
                            ymin, ymax, zmin, zmax and interface_NAME per surface (required)
   --algorithm hxt|delaunay Gmsh's 3D algorithm: HXT (Mesh.Algorithm3D = 10, default) or Delaunay (1);
                            both followed by Gmsh's default tet optimizer (Mesh.Optimize = 1)
   --threads N              threads for Gmsh (General.NumThreads; default 1; HXT uses them)
-  --report FILE.json       counts, timings and quality: equilateral mean ratio min/mean/std and
+  --report FILE.json       counts, timings, the size field (size_near_surface and size_distance, null
+                           without one) and quality: equilateral mean ratio min/mean/std and
                            min/max dihedral angle, computed by meccano's own quality functions
   --quiet                  no progress output and no Gmsh messages
   --help                   this text
@@ -63,14 +77,28 @@ using meccano::reference::UsageError;
 
 enum class Algorithm { hxt, delaunay };
 
+// Size near_surface at the surfaces, growing linearly to --size at `distance` from them.
+struct SizeField {
+  double near_surface = 0.0;
+  double distance = 0.0;
+};
+
 struct Options {
   meccano::reference::CommonOptions common;
   Algorithm algorithm = Algorithm::hxt;
   int threads = 1;
+  std::optional<SizeField> size_field;
 };
+
+double parse_positive(const std::string& option, const std::string& text) {
+  const double number = meccano::reference::parse_number(option, text);
+  if (!(number > 0)) throw UsageError(option + " must be positive");
+  return number;
+}
 
 Options parse_options(int argc, char** argv) {
   Options options;
+  std::optional<double> size_near_surface, size_distance;
   meccano::reference::parse_arguments(argc, argv, usage_text, options.common,
                                       [&](const std::vector<std::string>& args, std::size_t& i) {
     const std::string& arg = args[i];
@@ -84,11 +112,22 @@ Options parse_options(int argc, char** argv) {
       if (threads != std::floor(threads) || threads < 1 || threads > 1024)
         throw UsageError("--threads takes an integer between 1 and 1024");
       options.threads = static_cast<int>(threads);
+    } else if (arg == "--size-near-surface") {
+      size_near_surface = parse_positive(arg, meccano::reference::option_value(args, i));
+    } else if (arg == "--size-distance") {
+      size_distance = parse_positive(arg, meccano::reference::option_value(args, i));
     } else {
       return false;
     }
     return true;
   });
+  if (size_near_surface.has_value() != size_distance.has_value())
+    throw UsageError("--size-near-surface and --size-distance go together: give both or neither");
+  if (size_near_surface) {
+    if (*size_near_surface > *options.common.size)
+      throw UsageError("--size-near-surface must not exceed --size (the size far from the surfaces)");
+    options.size_field = SizeField{*size_near_surface, *size_distance};
+  }
   return options;
 }
 
@@ -181,6 +220,22 @@ BoxEntities add_box(const meccano::Box& box, double h) {
   return entities;
 }
 
+// The background mesh size of --size-near-surface: Gmsh's Threshold law on the exact distance to the
+// surfaces' triangles. Gmsh 4.8.4's own Distance field cannot serve: on a discrete surface it samples no
+// point (a Distance + Threshold field on the kept surface left the mesh unchanged, measured), so the
+// distance is meccano's, through Gmsh's mesh size callback. Gmsh takes the smallest of this size and
+// those of the geometry (box corners at --size, the kept triangles), so the triangles still set the
+// size on S itself.
+void set_size_field(const std::vector<meccano::TriangleSurface>& surfaces, const SizeField& field, double size) {
+  auto trees = std::make_shared<std::vector<meccano::TriangleBVH>>(surfaces.begin(), surfaces.end());
+  gmsh::model::mesh::setSizeCallback([trees, field, size](int, int, double x, double y, double z) {
+    double distance = std::numeric_limits<double>::infinity();
+    for (const auto& tree : *trees)
+      distance = std::min(distance, std::sqrt(tree.closest_point({x, y, z}).squared_distance));
+    return std::min(size, field.near_surface + (size - field.near_surface) * distance / field.distance);
+  });
+}
+
 void add_named_group(int dim, const std::vector<int>& entities, const std::string& name) {
   const int group = gmsh::model::addPhysicalGroup(dim, entities);
   gmsh::model::setPhysicalName(dim, group, name);
@@ -237,6 +292,11 @@ void write_report(const meccano::reference::ReferenceRun& run, const Options& op
         json.key("gmsh_version").value(version)
             .key("algorithm").value(options.algorithm == Algorithm::hxt ? "hxt" : "delaunay")
             .key("threads").value(options.threads);
+        if (options.size_field)
+          json.key("size_near_surface").value(options.size_field->near_surface)
+              .key("size_distance").value(options.size_field->distance);
+        else
+          json.key("size_near_surface").null().key("size_distance").null();
       },
       total_seconds, *options.common.report);
 }
@@ -262,9 +322,11 @@ int run(const Options& options) {
   // Every surface is read and validated before Gmsh starts: the same inputs as meccano-immerse, with
   // the same messages.
   const std::vector<meccano::TriangleSurface> surfaces = meccano::reference::read_valid_surfaces(common, progress);
+  const char* size_option = options.size_field ? "--size-near-surface" : "--size";
+  const double size_at_surfaces = options.size_field ? options.size_field->near_surface : *common.size;
   for (const auto& surface : surfaces)
-    if (const double edge = mean_edge_length(surface); *common.size < finest_size_for_kept_triangles * edge)
-      progress.say("warning: --size ", *common.size, " is below ", finest_size_for_kept_triangles,
+    if (const double edge = mean_edge_length(surface); size_at_surfaces < finest_size_for_kept_triangles * edge)
+      progress.say("warning: ", size_option, " ", size_at_surfaces, " is below ", finest_size_for_kept_triangles,
                    " x the mean edge length ", edge, " of surface ", surface.name,
                    ": next to its kept triangles Gmsh leaves nearly flat tets");
 
@@ -283,6 +345,7 @@ int run(const Options& options) {
   const BoxEntities box = add_box(common.box, *common.size);
   gmsh::model::geo::synchronize();
   gmsh::model::mesh::embed(2, surface_entities, 3, box.volume);
+  if (options.size_field) set_size_field(surfaces, *options.size_field, *common.size);
 
   add_named_group(3, {box.volume}, "domain");
   for (int side = 0; side < 6; ++side)
@@ -290,6 +353,9 @@ int run(const Options& options) {
   for (std::size_t s = 0; s < surfaces.size(); ++s)
     add_named_group(2, {surface_entities[s]}, "interface_" + surfaces[s].name);
 
+  if (options.size_field)
+    progress.say("gmsh: size field: ", options.size_field->near_surface, " at the surfaces, growing to ", *common.size,
+                 " at distance ", options.size_field->distance);
   progress.say("gmsh: meshing with ", options.algorithm == Algorithm::hxt ? "HXT" : "Delaunay", ", size ",
                *common.size, ", ", options.threads, " thread(s)");
   const auto meshing_start = Clock::now();

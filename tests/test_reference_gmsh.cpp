@@ -1,6 +1,7 @@
 // reference-gmsh (meshes/reference_gmsh.cpp): the Gmsh reference mesh, read back with the Gmsh library.
 // Checked: orientation and volume of the tets, the interface is the input surface as given and made of
-// interior faces, the box sides tile the boundary, the report agrees with the mesh, and the error paths.
+// interior faces, the box sides tile the boundary, the report agrees with the mesh, the size field refines
+// near the surface, and the error paths.
 
 #include <meccano/geometry.hpp>
 #include <meccano/quality.hpp>
@@ -125,6 +126,16 @@ double number_after(const std::string& text, const std::string& key) {
 class ReferenceGmshCliTest : public testing::ScratchDirectoryTest {
  protected:
   ReferenceGmshCliTest() : ScratchDirectoryTest("meccano-reference-gmsh") {}
+
+  // The surface as the OBJ file `name`.obj in the directory; returns its path.
+  std::string write_obj(const TriangleSurface& surface, const std::string& name) const {
+    const std::string file = path(name + ".obj");
+    std::ofstream out(file);
+    out.precision(17);
+    for (const auto& p : surface.points) out << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+    for (const auto& t : surface.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    return file;
+  }
 };
 
 // One run on the cube example at --size 0.1, shared by the tests that inspect its output.
@@ -250,13 +261,7 @@ TEST_F(ReferenceGmshCubeTest, ReportAgreesWithTheMesh) {
 TEST_F(ReferenceGmshCliTest, TwoSurfacesWithTheCommaBoxAndDelaunay) {
   const auto pair = testing::stacked_pair(4);
   std::vector<std::string> files;
-  for (const auto& surface : pair) {
-    files.push_back(path(surface.name + std::to_string(files.size()) + ".obj"));
-    std::ofstream out(files.back());
-    out.precision(17);
-    for (const auto& p : surface.points) out << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-    for (const auto& t : surface.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
-  }
+  for (const auto& surface : pair) files.push_back(write_obj(surface, surface.name + std::to_string(files.size())));
   const ToolRun run = run_reference_gmsh("--box 0,0,0,1,1,1 --surface " + files[0] + " --surface " + files[1] +
                                          ":top --size 0.25 --algorithm delaunay --threads 2 --output " + path("pair.msh"));
   ASSERT_EQ(run.status, 0) << run.output;
@@ -266,6 +271,51 @@ TEST_F(ReferenceGmshCliTest, TwoSurfacesWithTheCommaBoxAndDelaunay) {
   ASSERT_TRUE(pair_mesh.triangles_of_group.count("interface_top"));
   EXPECT_EQ(pair_mesh.triangles_of_group.at("interface_1").size(), pair[0].triangles.size());
   EXPECT_EQ(pair_mesh.triangles_of_group.at("interface_top").size(), pair[1].triangles.size());
+}
+
+// The mean edge length of the tets whose centroid lies between `from` and `to` away from the surface.
+double mean_edge_of_tets_between(const MshContents& mesh, const TriangleBVH& surface, double from, double to) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (const auto& tet : mesh.tets) {
+    const TetPoints p = mesh.points(tet);
+    const double distance = std::sqrt(surface.closest_point((p[0] + p[1] + p[2] + p[3]) / 4.0).squared_distance);
+    if (distance <= from || distance >= to) continue;
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) sum += (p[a] - p[b]).norm() / 6.0;
+    ++count;
+  }
+  EXPECT_GT(count, 100u) << "too few tets between " << from << " and " << to;
+  return sum / static_cast<double>(count);
+}
+
+// The kept triangles (mean edge 0.044) already make the tets next to S small; the field (0.045 at S,
+// growing to --size 0.4 over a distance of 1) must also keep the tets further out smaller. Measured with
+// HXT: their mean edge 0.24 without the field, 0.14 with it.
+TEST_F(ReferenceGmshCliTest, SizeFieldMakesTheTetsNearTheSurfaceSmaller) {
+  const TriangleSurface patch = testing::paper_like_patch(16);
+  const std::string base = "--box 0 0 0 1 1 1 --surface " + write_obj(patch, "patch") + " --size 0.4 --quiet";
+  const ToolRun plain = run_reference_gmsh(base + " --output " + path("plain.msh") + " --report " + path("plain.json"));
+  ASSERT_EQ(plain.status, 0) << plain.output;
+  const ToolRun graded = run_reference_gmsh(base + " --size-near-surface 0.045 --size-distance 1 --output " +
+                                            path("graded.msh") + " --report " + path("graded.json"));
+  ASSERT_EQ(graded.status, 0) << graded.output;
+
+  const TriangleBVH tree(patch);
+  const double without_field = mean_edge_of_tets_between(read_msh(path("plain.msh")), tree, 0.1, 0.3);
+  const double with_field = mean_edge_of_tets_between(read_msh(path("graded.msh")), tree, 0.1, 0.3);
+  EXPECT_LT(with_field, 0.75 * without_field) << "tets 0.1 to 0.3 away from S: mean edge " << with_field
+                                              << " with the field, " << without_field << " without";
+
+  const auto report = [&](const std::string& name) {
+    std::ifstream in(path(name));
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  };
+  EXPECT_EQ(number_after(report("graded.json"), "size_near_surface"), 0.045);
+  EXPECT_EQ(number_after(report("graded.json"), "size_distance"), 1.0);
+  EXPECT_NE(report("plain.json").find("\"size_near_surface\": null"), std::string::npos) << report("plain.json");
 }
 
 TEST_F(ReferenceGmshCliTest, MissingSurfaceExitsOneAndWritesNothing) {
@@ -285,6 +335,12 @@ TEST_F(ReferenceGmshCliTest, UsageErrorsExitTwoWithAMessage) {
       {"--box 0 0 0 1 1 1 --size 0.1" + rest, "--surface is required"},
       {"--box 0 0 0 1 1 1 --surface a.obj --size 0" + rest, "--size must be positive"},
       {"--box 0 0 0 1 1 1 --surface a.obj --size 0.1 --algorithm frontal" + rest, "the algorithms available are"},
+      {"--box 0 0 0 1 1 1 --surface a.obj --size 0.1 --size-near-surface 0.05" + rest, "go together"},
+      {"--box 0 0 0 1 1 1 --surface a.obj --size 0.1 --size-distance 0.3" + rest, "go together"},
+      {"--box 0 0 0 1 1 1 --surface a.obj --size 0.1 --size-near-surface 0.2 --size-distance 0.3" + rest,
+       "must not exceed --size"},
+      {"--box 0 0 0 1 1 1 --surface a.obj --size 0.1 --size-near-surface 0.05 --size-distance 0" + rest,
+       "--size-distance must be positive"},
       {"--box 0 0 0 1 1 1 --surface a.obj --surface b.obj:1 --size 0.1" + rest, "two surfaces are named 1"},
       {"--box 0 0 0 1 1 1 --surface a.obj --size 0.1 --output " + path("usage.vtk"), "only .msh output"},
   };

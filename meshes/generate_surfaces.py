@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Writes the immersed surfaces used by the demos, as OBJ files in this folder.
+"""Writes the immersed surfaces used by the demos, as OBJ files in the current folder (meshes/ for the
+committed ones) or in --output-dir.
 
 cube_example.obj   the paper-like patch of the cube example: over (x, y) in [0.2, 0.8]^2,
                    z = 0.42 + 0.12 u v + 0.10 sin(pi u) sin(pi v), u = (x - 0.2)/0.6, v = (y - 0.2)/0.6,
@@ -9,10 +10,11 @@ cube_example.obj   the paper-like patch of the cube example: over (x, y) in [0.2
 spherical_cap.obj  a cap of the sphere of radius 0.4 centred at (0.5, 0.5, 0.2), polar angle up to 65
                    degrees: a circular rim, no natural corners.
 
-Usage: generate_surfaces.py [N]   (default N = 48)
+Usage: generate_surfaces.py [--output-dir DIR] [N]   (default N = 48, DIR = the current folder)
 """
+import argparse
 import math
-import sys
+import os
 
 
 def write_obj(path, points, triangles, comment):
@@ -67,9 +69,16 @@ def spherical_cap(rings):
 
 
 def main():
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 48
-    write_obj("cube_example.obj", *cube_example(n), f"cube example patch, {n} x {n} grid (generate_surfaces.py)")
-    write_obj("spherical_cap.obj", *spherical_cap(n // 2), f"spherical cap, {n // 2} rings (generate_surfaces.py)")
+    parser = argparse.ArgumentParser(description="Writes cube_example.obj and spherical_cap.obj.")
+    parser.add_argument("n", nargs="?", type=int, default=48, help="grid resolution N (the cap gets N // 2 rings)")
+    parser.add_argument("--output-dir", default=".", help="folder to write into (created if missing)")
+    args = parser.parse_args()
+    if args.n < 2:
+        parser.error(f"N must be at least 2 (got {args.n})")
+    os.makedirs(args.output_dir, exist_ok=True)
+    n, path = args.n, lambda name: os.path.join(args.output_dir, name)
+    write_obj(path("cube_example.obj"), *cube_example(n), f"cube example patch, {n} x {n} grid (generate_surfaces.py)")
+    write_obj(path("spherical_cap.obj"), *spherical_cap(n // 2), f"spherical cap, {n // 2} rings (generate_surfaces.py)")
 
 
 if __name__ == "__main__":

@@ -7,6 +7,8 @@
 # the module's tet count is interpolated (log-log) between its two nearest runs, so the ratio compares
 # meshes of the same size. Seconds are the tools' own "total" (reading the surface, meshing or
 # inserting, the quality pass; not the MSH write); peak RSS from /usr/bin/time. Prints a Markdown table.
+# The interpolation is compare_references.py's; compare_references.sh is the wider comparison (TetGen,
+# Gmsh Delaunay, more surfaces, the solver, a moving surface: doc/comparison.md).
 #
 # Usage: tests/bench/compare_gmsh.sh [--threads N] [L ...]   (default l_r: 0.03125 0.015625 0.0078125;
 #        Gmsh sizes: 0.05 0.035 0.025 0.018 0.0125). Run after scripts/build.sh, from anywhere.
@@ -42,20 +44,16 @@ done
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(date -u +%F), $threads threads"
 echo
 /usr/bin/python3 - "$work" "${resolutions[*]}" "${sizes[*]}" <<'EOF'
-import json, math, sys
+import json, sys
+sys.path.insert(0, "tests/bench")
+from compare_references import loglog_interpolate
 work, resolutions, sizes = sys.argv[1], sys.argv[2].split(), sys.argv[3].split()
 load = lambda name: (json.load(open(f"{work}/{name}.json")), int(open(f"{work}/{name}.rss").read()) / 1024)
 gmsh = sorted((load(f"gmsh_{h}") + (h,) for h in sizes), key=lambda g: g[0]["tets"])
 
 def hxt_seconds(tets):
     """HXT's total seconds at `tets`, interpolated in log-log between its two nearest runs."""
-    lo = max((g for g in gmsh if g[0]["tets"] <= tets), key=lambda g: g[0]["tets"], default=gmsh[0])
-    hi = min((g for g in gmsh if g[0]["tets"] >= tets), key=lambda g: g[0]["tets"], default=gmsh[-1])
-    if lo is hi:
-        lo, hi = (gmsh[0], gmsh[1]) if tets < gmsh[0][0]["tets"] else (gmsh[-2], gmsh[-1])
-    (a, _, _), (b, _, _) = lo, hi
-    t = math.log(tets / a["tets"]) / math.log(b["tets"] / a["tets"])
-    return math.exp(math.log(a["seconds"]["total"]) + t * math.log(b["seconds"]["total"] / a["seconds"]["total"]))
+    return loglog_interpolate([(report["tets"], report["seconds"]["total"]) for report, _, _ in gmsh], tets)[0]
 
 print("| mesh | tets | seconds | k tets/s | HXT s at these tets | HXT ÷ this | η min | η mean | min dih. | max dih. | peak RSS |")
 print("|---|---|---|---|---|---|---|---|---|---|---|")

@@ -13,6 +13,7 @@
 
 #include "reference_common.hpp"
 
+#include <meccano/atomic_file.hpp>
 #include <meccano/error.hpp>
 #include <meccano/geometry.hpp>
 #include <meccano/tet_mesh.hpp>
@@ -22,7 +23,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <filesystem>
 #include <map>
 #include <limits>
 #include <memory>
@@ -30,8 +30,6 @@
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <unistd.h>
 
 namespace {
 
@@ -261,29 +259,18 @@ meccano::reference::MeshSummary summarize_mesh() {
   });
 }
 
-// gmsh::write picks the format from the extension, so the temporary name ends in .msh too; it lives in
-// the target's directory so that the rename is atomic.
-void write_msh_atomically(const std::string& path) {
-  namespace fs = std::filesystem;
-  const std::string temporary = path + ".tmp" + std::to_string(::getpid()) + ".msh";
+// gmsh::write, its errors (thrown as strings) as InputError naming the file.
+void write_gmsh_msh(const std::string& path) {
   try {
-    gmsh::write(temporary);
+    gmsh::write(path);
   } catch (const std::string& gmsh_error) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
     throw meccano::InputError("cannot write " + path + ": " + gmsh_error);
-  }
-  std::error_code error;
-  fs::rename(temporary, path, error);
-  if (error) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
-    throw meccano::InputError("cannot write " + path + ": " + error.message());
   }
 }
 
 // Key names follow meccano::QualitySummary, so that the reference tools' reports read alike.
-void write_report(const meccano::reference::ReferenceRun& run, const Options& options, double total_seconds) {
+void write_report(const meccano::reference::ReferenceRun& run, const Options& options, double total_seconds,
+                  const std::string& path) {
   std::string version;
   gmsh::option::getString("General.Version", version);
   meccano::reference::write_report(
@@ -298,7 +285,7 @@ void write_report(const meccano::reference::ReferenceRun& run, const Options& op
         else
           json.key("size_near_surface").null().key("size_distance").null();
       },
-      total_seconds, *options.common.report);
+      total_seconds, path);
 }
 
 // Gmsh cannot split the kept triangles, and when the tets around them must be much smaller HXT leaves
@@ -377,12 +364,16 @@ int run(const Options& options) {
                                                summarize_mesh(), meshing_seconds};
   progress.say("gmsh: ", meccano::reference::describe(record.mesh), " in ", record.meshing_seconds, " s");
 
-  write_msh_atomically(common.output);
+  // The mesh and the report appear together, or neither (a file already there stays as it was).
+  meccano::StagedFiles files;
+  files.write(common.output, write_gmsh_msh);
+  if (common.report)
+    files.write(*common.report, [&](const std::string& path) {
+      write_report(record, options, meccano::reference::seconds_since(start), path);
+    });
+  files.commit();
   progress.say("wrote ", common.output);
-  if (common.report) {
-    write_report(record, options, meccano::reference::seconds_since(start));
-    progress.say("wrote ", *common.report);
-  }
+  if (common.report) progress.say("wrote ", *common.report);
   return 0;
 }
 

@@ -253,6 +253,16 @@ TEST_F(ReferenceTetgenCliTest, SurfaceCrossingTheBoxExitsOneAndWritesNothing) {
     EXPECT_EQ(entry.path().string().find("crossing"), std::string::npos) << "left behind: " << entry.path();
 }
 
+TEST_F(ReferenceTetgenCliTest, AnUnwritableReportLeavesNoMeshEither) {
+  const auto files = write_objs({testing::tilted_plane(4)});
+  const ToolRun run = run_reference_tetgen("--box 0 0 0 1 1 1 --surface " + files[0] + " --size 0.3 --output " +
+                                           path("alone.msh") + " --report /nonexistent-dir/alone.json");
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_NE(run.output.find("cannot write /nonexistent-dir/alone.json: "), std::string::npos) << run.output;
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().string().find("alone"), std::string::npos) << "left behind: " << entry.path();
+}
+
 TEST_F(ReferenceTetgenCliTest, UsageErrorsExitTwoWithAMessage) {
   const std::string rest = " --output " + path("usage.msh");
   const std::string valid = "--box 0 0 0 1 1 1 --surface a.obj --size 0.1";

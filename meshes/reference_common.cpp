@@ -83,16 +83,7 @@ const std::string& option_value(const std::vector<std::string>& args, std::size_
 }
 
 double parse_number(const std::string& option, const std::string& text) {
-  std::size_t used = 0;
-  double value = 0.0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value))
-    throw UsageError(option + ": '" + text + "' is not a finite number");
-  return value;
+  return tools::parse_finite_number<UsageError>(option, text);
 }
 
 void parse_arguments(int argc, char** argv, const char* usage_text, CommonOptions& common,
@@ -188,6 +179,16 @@ void write_report(const ReferenceRun& run, const std::function<void(JsonWriter&)
       .end_object()
       .end_object();
   write_file_atomically(path, [&](std::ostream& out) { out << json.str(); });
+}
+
+void write_outputs(const CommonOptions& common, const Progress& progress, const PathWriter& mesh_writer,
+                   const PathWriter& report_writer) {
+  StagedFiles files;
+  files.write(common.output, mesh_writer);
+  if (common.report) files.write(*common.report, report_writer);
+  files.commit();
+  progress.say("wrote ", common.output);
+  if (common.report) progress.say("wrote ", *common.report);
 }
 
 int run_tool(const std::string& tool, const std::function<int()>& parse_and_run) {

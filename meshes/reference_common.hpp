@@ -109,6 +109,12 @@ struct ReferenceRun {
 void write_report(const ReferenceRun& run, const std::function<void(JsonWriter&)>& tool_keys, double total_seconds,
                   const std::string& path);
 
+// The tool's outputs: the mesh (mesh_writer to the path given) and, with --report, the report, staged so
+// that both appear or neither (a file already there stays as it was); then says where they went.
+using PathWriter = std::function<void(const std::string& path)>;
+void write_outputs(const CommonOptions& common, const Progress& progress, const PathWriter& mesh_writer,
+                   const PathWriter& report_writer);
+
 // What main() of a tool does: runs parse_and_run and maps its exceptions to exit statuses, UsageError
 // to 2 with a pointer to --help, any other std::exception to 1, each message prefixed by the tool's name.
 int run_tool(const std::string& tool, const std::function<int()>& parse_and_run);

@@ -13,7 +13,6 @@
 
 #include "reference_common.hpp"
 
-#include <meccano/atomic_file.hpp>
 #include <meccano/error.hpp>
 #include <meccano/geometry.hpp>
 #include <meccano/tet_mesh.hpp>
@@ -364,16 +363,9 @@ int run(const Options& options) {
                                                summarize_mesh(), meshing_seconds};
   progress.say("gmsh: ", meccano::reference::describe(record.mesh), " in ", record.meshing_seconds, " s");
 
-  // The mesh and the report appear together, or neither (a file already there stays as it was).
-  meccano::StagedFiles files;
-  files.write(common.output, write_gmsh_msh);
-  if (common.report)
-    files.write(*common.report, [&](const std::string& path) {
-      write_report(record, options, meccano::reference::seconds_since(start), path);
-    });
-  files.commit();
-  progress.say("wrote ", common.output);
-  if (common.report) progress.say("wrote ", *common.report);
+  meccano::reference::write_outputs(common, progress, write_gmsh_msh, [&](const std::string& path) {
+    write_report(record, options, meccano::reference::seconds_since(start), path);
+  });
   return 0;
 }
 

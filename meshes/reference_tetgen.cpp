@@ -360,27 +360,21 @@ int run(const Options& options) {
     progress.say("warning: TetGen left tets far above the volume bound ", bound, " (the largest ", summary.max_volume,
                  options.keep_surface ? "): with --keep-surface it may not split the facets to refine" : ")");
 
-  // The mesh and the report appear together, or neither (a file already there stays as it was).
-  meccano::StagedFiles files;
-  files.write(common.output, [&](const std::string& path) { write_msh41(mesh, surfaces, common.box, path); });
-  if (common.report) {
-    files.write(*common.report, [&](const std::string& path) {
-      meccano::reference::write_report(
-          record,
-          [&](meccano::JsonWriter& json) {
-            json.key("switches").value(switches)
-                .key("radius_edge").value(options.radius_edge);
-            if (options.min_dihedral_deg) json.key("min_dihedral_bound_deg").value(*options.min_dihedral_deg);
-            else json.key("min_dihedral_bound_deg").null();
-            json.key("keep_surface").value(options.keep_surface)
-                .key("volume_bound").value(regular_tet_volume(*common.size));
-          },
-          meccano::reference::seconds_since(start), path);
-    });
-  }
-  files.commit();
-  progress.say("wrote ", common.output);
-  if (common.report) progress.say("wrote ", *common.report);
+  meccano::reference::write_outputs(
+      common, progress, [&](const std::string& path) { write_msh41(mesh, surfaces, common.box, path); },
+      [&](const std::string& path) {
+        meccano::reference::write_report(
+            record,
+            [&](meccano::JsonWriter& json) {
+              json.key("switches").value(switches)
+                  .key("radius_edge").value(options.radius_edge);
+              if (options.min_dihedral_deg) json.key("min_dihedral_bound_deg").value(*options.min_dihedral_deg);
+              else json.key("min_dihedral_bound_deg").null();
+              json.key("keep_surface").value(options.keep_surface)
+                  .key("volume_bound").value(regular_tet_volume(*common.size));
+            },
+            meccano::reference::seconds_since(start), path);
+      });
   return 0;
 }
 

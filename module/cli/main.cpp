@@ -173,18 +173,7 @@ std::vector<double> parse_numbers(const std::string& option, const std::string& 
   std::vector<double> values;
   std::stringstream stream(text);
   std::string item;
-  while (std::getline(stream, item, ',')) {
-    std::size_t used = 0;
-    double value = 0.0;
-    try {
-      value = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || !std::isfinite(value))
-      throw UsageError(option + ": '" + item + "' is not a finite number");
-    values.push_back(value);
-  }
+  while (std::getline(stream, item, ',')) values.push_back(meccano::tools::parse_finite_number<UsageError>(option, item));
   if (values.size() != count)
     throw UsageError(option + " takes " + std::to_string(count) + " comma-separated numbers, got '" + text + "'");
   return values;

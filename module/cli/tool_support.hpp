@@ -1,16 +1,33 @@
 // What the project's command-line tools share (meccano-immerse, and reference-gmsh and reference-tetgen
-// in meshes/): the FILE[:NAME] surface argument and timestamped progress lines. Header-only; not part
+// in meshes/): number arguments, the FILE[:NAME] surface argument and timestamped progress lines. Header-only; not part
 // of the installed library.
 #pragma once
 
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <iostream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
 namespace meccano::tools {
+
+// A finite number that is the whole text; Error (the tool's usage error) naming the option otherwise.
+template <class Error>
+double parse_finite_number(const std::string& option, const std::string& text) {
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value))
+    throw Error(option + ": '" + text + "' is not a finite number");
+  return value;
+}
 
 // FILE[:NAME] as (file, name), NAME defaulting to the surface's 1-based position. A colon followed by a
 // path separator belongs to the file name. A bad name throws Error (the tool's usage error) with why.

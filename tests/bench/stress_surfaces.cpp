@@ -30,6 +30,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -239,6 +240,14 @@ const char* outcome_name(Outcome outcome) {
 
 int main(int argc, char** argv) {
   const Options options = parse_options(argc, argv);
+  if (!options.dump_directory.empty()) {
+    std::error_code error;
+    std::filesystem::create_directories(options.dump_directory, error);
+    if (error) {
+      std::cerr << "stress_surfaces: cannot create " << options.dump_directory << ": " << error.message() << '\n';
+      return 2;
+    }
+  }
   const meccano::Box box{Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()};
   std::map<std::pair<Outcome, std::string>, int> counts;  // (outcome, reason) -> cases
   int accepted_cases = 0;

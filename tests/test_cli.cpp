@@ -114,6 +114,8 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
        "the rules are positive, negative, positive-only and negative-only"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --threads 0 --output " + path("a.msh"),
        "--threads must be at least 1"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --fallback-sweeps -1 --output " + path("a.msh"),
+       "--fallback-sweeps must not be negative"},
       {"--box 0,0,0,1,1,1 --histograms h.csv --output " + path("a.msh"), "need at least one --surface"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --stage projection --histograms h.csv --output " +
            path("a.msh"),

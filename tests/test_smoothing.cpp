@@ -9,6 +9,7 @@
 #include <meccano/pipeline.hpp>
 #include <meccano/quality.hpp>
 #include <meccano/smoothing.hpp>
+#include <meccano/surface.hpp>
 
 #include <test_surfaces.hpp>
 
@@ -254,6 +255,33 @@ TEST(Smoothing, BandModeMovesOnlyNodesNearTheSurface) {
     else moved_in_band += result.mesh.points[v] != projected[v];
   }
   EXPECT_GT(moved_in_band, 0);
+}
+
+// On this disk (found by stress_surfaces) untangling towards the meccano target stalls at a few inverted
+// tets on either side of S for any number of sweeps; the equilateral target untangles them, and the
+// smoothing then aims at the meccano target again.
+TEST(Smoothing, FallsBackToTheEquilateralTargetWhereTheMeccanoTargetStalls) {
+  const TriangleSurface surface = read_surface(std::string(MECCANO_TEST_DATA_DIR) + "/small_disk_meccano_target_stalls.obj");
+  InsertionOptions options;
+  options.resolution = 0.041507854398402787;
+  options.approximation.side_rule = SideRule::positive_only;
+  const InsertionResult result = insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {&surface, 1}, options);
+  EXPECT_TRUE(result.smoothing.untangled());
+  EXPECT_EQ(result.smoothing.fallback_sweep, options.smoothing.fallback_sweeps + 1);
+  ASSERT_FALSE(result.smoothing.sweeps.empty());
+  EXPECT_EQ(result.smoothing.sweeps.back().target, SmoothingTarget::meccano);
+  EXPECT_TRUE(verify_mesh(result.mesh, {.physical = true}).ok());
+  EXPECT_EQ(folded_triangles(result.surfaces[0].projection), 0);
+  EXPECT_GE(result.quality_after_smoothing.meccano.min, 0.29);
+
+  options.smoothing.fallback_sweeps = 0;
+  options.smoothing.max_sweeps = 40;
+  try {
+    insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {&surface, 1}, options);
+    ADD_FAILURE() << "the meccano target untangles this disk: the test lost its point";
+  } catch (const MeshingError& failure) {
+    EXPECT_NE(std::string(failure.what()).find("tets are still inverted"), std::string::npos) << failure.what();
+  }
 }
 
 TEST(Smoothing, UntanglesTowardsTheEquilateralTarget) {

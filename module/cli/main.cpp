@@ -67,6 +67,9 @@ Options:
                            counterpart, the paper's choice) or equilateral
   --max-sweeps N           at most N smoothing sweeps (default 100); the run fails if tets are still
                            inverted then
+  --fallback-sweeps N      with the meccano target, tets still inverted after N sweeps are untangled
+                           towards the equilateral target, and the smoothing then aims at the meccano
+                           target again (default 20; 0: never)
   --threads N              OpenMP threads (default: all cores); the result does not depend on it
   --report FILE.json       timings, counts and quality before and after smoothing (keys: tets, nodes,
                            inverted, quality.before_smoothing / after_smoothing with meccano and
@@ -255,6 +258,9 @@ Options parse_options(int argc, char** argv) {
     } else if (arg == "--max-sweeps") {
       options.smoothing.max_sweeps = parse_int(arg, value());
       if (options.smoothing.max_sweeps < 1) throw UsageError("--max-sweeps must be at least 1");
+    } else if (arg == "--fallback-sweeps") {
+      options.smoothing.fallback_sweeps = parse_int(arg, value());
+      if (options.smoothing.fallback_sweeps < 0) throw UsageError("--fallback-sweeps must not be negative");
     } else if (arg == "--threads") {
       options.threads = parse_int(arg, value());
       if (*options.threads < 1) throw UsageError("--threads must be at least 1");

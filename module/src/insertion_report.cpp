@@ -58,13 +58,14 @@ void write_smoothing(JsonWriter& json, const SmoothingStats& s, double seconds) 
   json.key("surface_nodes").value(s.surface_nodes).key("rim_nodes").value(s.rim_nodes);
   json.key("active_tets").value(s.active_tets).key("colours").value(s.colours);
   json.key("inverted_before").value(s.inverted_before).key("inverted_after").value(s.inverted_after);
-  json.key("untangling_sweeps").value(s.untangling_sweeps);
+  json.key("untangling_sweeps").value(s.untangling_sweeps).key("fallback_sweep").value(s.fallback_sweep);
   json.key("sweeps").begin_array();
   for (const SweepRecord& sweep : s.sweeps) {
     json.begin_object();
     json.key("inverted").value(sweep.inverted).key("nodes_optimised").value(sweep.nodes_optimised);
     json.key("min_quality").value(sweep.min_quality).key("mean_quality").value(sweep.mean_quality);
     json.key("power").value(sweep.power).key("objective").value(sweep.objective);
+    json.key("target").value(sweep.target == SmoothingTarget::meccano ? "meccano" : "equilateral");
     json.key("seconds").value(sweep.seconds).end_object();
   }
   json.end_array();

@@ -129,8 +129,10 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
   report(options, "smoothing: ", smoothing.inner_nodes + smoothing.box_nodes + smoothing.surface_nodes + smoothing.rim_nodes,
          " free nodes (", smoothing.surface_nodes, " on surfaces, ", smoothing.rim_nodes, " on rims), ", smoothing.colours,
          " colours; ", smoothing.inverted_before, " inverted tets before, ", smoothing.inverted_after, " after ",
-         smoothing.sweeps.size(), " sweeps (untangled after ", smoothing.untangling_sweeps, "); quality min ",
-         last.min_quality, " mean ", last.mean_quality);
+         smoothing.sweeps.size(), " sweeps (untangled after ", smoothing.untangling_sweeps,
+         smoothing.fallback_sweep > 0 ? ", towards the equilateral target from sweep " + std::to_string(smoothing.fallback_sweep)
+                                      : std::string(),
+         "); quality min ", last.min_quality, " mean ", last.mean_quality);
   if (!smoothing.untangled()) return result;  // the caller may retry, or reports the failure
   check_stage(result.mesh, "smoothing");
   result.quality_after_smoothing = summarize_quality(result.mesh);

@@ -120,15 +120,9 @@ class Smoother {
   Smoother(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, const SmoothingOptions& options)
       : mesh_(mesh), surfaces_(surfaces), options_(options), stars_(vertex_to_tets(mesh)) {
     oriented_.resize(mesh.tets.size());
-    target_inverse_.resize(mesh.tets.size());
-    const Matrix3d equilateral_inverse = equilateral_target().inverse();
 #pragma omp parallel for schedule(static)
-    for (TetId t = 0; t < mesh.num_tets(); ++t) {
-      oriented_[t] = mesh.oriented_tet(t);
-      target_inverse_[t] = options.target == SmoothingTarget::meccano
-                               ? Matrix3d(edge_matrix(oriented_computational_points(mesh, t)).inverse())
-                               : equilateral_inverse;
-    }
+    for (TetId t = 0; t < mesh.num_tets(); ++t) oriented_[t] = mesh.oriented_tet(t);
+    aim_at(options.target);
     classify_nodes();
   }
 
@@ -139,6 +133,17 @@ class Smoother {
     Matrix3d w;
     w << 1.0, 0.5, 0.5, 0.0, std::sqrt(3.0) / 2.0, std::sqrt(3.0) / 6.0, 0.0, 0.0, std::sqrt(2.0 / 3.0);
     return w;
+  }
+  // Sets every tet's W^-1 for `target`.
+  void aim_at(SmoothingTarget target) {
+    target_ = target;
+    target_inverse_.resize(mesh_.tets.size());
+    const Matrix3d equilateral_inverse = equilateral_target().inverse();
+#pragma omp parallel for schedule(static)
+    for (TetId t = 0; t < mesh_.num_tets(); ++t)
+      target_inverse_[t] = target == SmoothingTarget::meccano
+                               ? Matrix3d(edge_matrix(oriented_computational_points(mesh_, t)).inverse())
+                               : equilateral_inverse;
   }
 
   void classify_nodes();
@@ -179,7 +184,9 @@ class Smoother {
   SmoothingOptions options_;
   VertexTets stars_;
   std::vector<std::array<VertexId, 4>> oriented_;
+  SmoothingTarget target_ = SmoothingTarget::meccano;  // what target_inverse_ holds now
   std::vector<Matrix3d> target_inverse_;
+  bool returned_from_fallback_ = false;  // did the smoothing aim at the meccano target again after the fallback?
   std::vector<NodeFreedom> freedom_;
   std::vector<std::vector<int>> hints_;  // per surface and node: the triangle of φ^-1(S) last holding it
   std::vector<std::vector<int>> triangle_start_, node_triangles_;  // per surface: node -> S_M triangles (CSR)
@@ -520,7 +527,21 @@ SmoothingStats Smoother::run() {
   int clean_sweeps = 0;
   std::int64_t fewest_inverted = std::numeric_limits<std::int64_t>::max();
   int stalled_sweeps = 0;
+  // A new target changes every node's objective: all of them get another look.
+  auto switch_target = [&](SmoothingTarget target) {
+    aim_at(target);
+    std::fill(last_optimised.begin(), last_optimised.end(), -1);
+  };
   for (int sweep = 1; sweep <= options_.max_sweeps; ++sweep) {
+    if (tangled_ && target_ == SmoothingTarget::meccano && options_.fallback_sweeps > 0 &&
+        (sweep > options_.fallback_sweeps || returned_from_fallback_)) {
+      // Untangling towards the meccano target stalled (or its smoothing tangled the mesh again).
+      switch_target(SmoothingTarget::equilateral);
+      if (stats_.fallback_sweep == 0) stats_.fallback_sweep = sweep;
+      untangling_epsilon_ = initial_untangling_epsilon;
+      fewest_inverted = std::numeric_limits<std::int64_t>::max();
+      stalled_sweeps = 0;
+    }
     const auto start = std::chrono::steady_clock::now();
     std::int64_t optimised = 0;
     for (const auto& group : colours) {
@@ -541,9 +562,10 @@ SmoothingStats Smoother::run() {
     record.nodes_optimised = optimised;
     record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     record.power = power();
-    // The objective can only be compared with the previous sweep's if both used the same power.
+    record.target = target_;
+    // The objective can only be compared with the previous sweep's if both used the same power and W.
     const bool comparable = !stats_.sweeps.empty() && stats_.sweeps.back().power == power() &&
-                            stats_.sweeps.back().inverted == 0;
+                            stats_.sweeps.back().target == target_ && stats_.sweeps.back().inverted == 0;
     const double previous_objective = comparable ? stats_.sweeps.back().objective : infinity;
     stats_.sweeps.push_back(record);
     // Untangling uses the paper's sum; once a sweep ends untangled, the next ones weigh bad tets more.
@@ -564,6 +586,11 @@ SmoothingStats Smoother::run() {
     untangling_epsilon_ = initial_untangling_epsilon;
     if (clean_sweeps++ == 0 && stats_.inverted_before > 0) stats_.untangling_sweeps = sweep;
     if (clean_sweeps >= options_.smoothing_sweeps || optimised == 0) break;
+    if (target_ != options_.target && !returned_from_fallback_) {
+      switch_target(options_.target);  // untangled by the fallback: smooth towards the chosen target
+      returned_from_fallback_ = true;
+      continue;
+    }
     if (comparable && previous_objective - record.objective <= options_.tolerance * previous_objective) break;
   }
   stats_.inverted_after = count_inverted(mesh_);

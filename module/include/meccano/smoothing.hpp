@@ -29,6 +29,13 @@
 //          its star's edge length) since it was last optimised. The sweeps stop after `smoothing_sweeps`
 //          sweeps that end with no inverted tet (the authors' rule), or earlier once such a sweep lowers
 //          the objective by less than `tolerance` (relative), or after `max_sweeps` sweeps.
+// Fallback If tets are still inverted after `fallback_sweeps` sweeps towards the meccano target, the
+//          untangling goes on towards the equilateral target, and the smoothing sweeps that follow the
+//          untangling aim at the meccano target again. Some projected S_M (a small disk, a few l_r across,
+//          whose rim moves by about l_r) leave stars whose meccano shapes cannot all be met: untangling
+//          stalls there, for any number of sweeps, while the equilateral target untangles it in about ten
+//          (doc/results.md, Step 4). Should the meccano smoothing tangle the mesh again, the equilateral
+//          target is kept to the end.
 // Modes    whole mesh (the paper), or a band: only nodes within `band_rings` edge rings of an S_M node.
 // Output   the moved mesh and the surfaces' updated parameters; statistics per sweep. `untangled` is false
 //          if inverted tets remain: the caller must not present that mesh as a result.
@@ -52,6 +59,7 @@ struct SmoothingOptions {
   SmoothingMode mode = SmoothingMode::whole_mesh;
   int band_rings = 3;
   int max_sweeps = 100;
+  int fallback_sweeps = 20;  // tangled sweeps towards the meccano target before the equilateral fallback; 0: never
   int smoothing_sweeps = 20;
   double tolerance = 1e-3;
   double power = 4.0;    // p of Σ η*^p once untangled; 1 is the paper's objective
@@ -64,6 +72,7 @@ struct SweepRecord {
   double min_quality = 0.0;         // 1/η against the target, over the tets of free nodes
   double mean_quality = 0.0;
   double power = 1.0;               // the exponent p the sweep minimised Σ η*^p with
+  SmoothingTarget target = SmoothingTarget::meccano;  // the target of the sweep's W
   double objective = 0.0;           // Σ η^p over those tets after the sweep
   double seconds = 0.0;
 };
@@ -78,6 +87,7 @@ struct SmoothingStats {
   std::int64_t inverted_before = 0;
   std::int64_t inverted_after = 0;
   int untangling_sweeps = 0;        // sweeps until no tet was inverted (0 if none was)
+  int fallback_sweep = 0;           // the first sweep towards the equilateral fallback target (0: none)
   std::vector<SweepRecord> sweeps;
   bool untangled() const { return inverted_after == 0; }
 };

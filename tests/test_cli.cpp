@@ -116,6 +116,8 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
        "--threads must be at least 1"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --fallback-sweeps -1 --output " + path("a.msh"),
        "--fallback-sweeps must not be negative"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --finer-retries -2 --output " + path("a.msh"),
+       "--finer-retries must not be negative"},
       {"--box 0,0,0,1,1,1 --histograms h.csv --output " + path("a.msh"), "need at least one --surface"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --stage projection --histograms h.csv --output " +
            path("a.msh"),

@@ -2,6 +2,7 @@
 // surface_interfaces, each surface's faces with the tets on both sides and one consistent normal.
 
 #include <meccano/cube_meccano.hpp>
+#include <meccano/error.hpp>
 #include <meccano/geometry.hpp>
 #include <meccano/pipeline.hpp>
 
@@ -131,6 +132,28 @@ TEST(InsertionOptions, ProgressReportsEveryStage) {
   for (const char* stage : {"volumetric", "approximation", "projection", "smoothing"})
     EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.rfind(stage, 0) == 0; }))
         << stage;
+}
+
+// Two tilted patches 0.03 apart: at l_r = 1/16 each V_M reaches the other surface and S_M cannot be
+// healed; the insertion retries both at l_r = 1/32, where they separate. With no retries it fails.
+TEST(InsertionOptions, SurfacesTooCloseForTheResolutionAreRetriedFiner) {
+  auto patch = [](double offset, const char* name) {
+    return testing::graph_patch([offset](double x, double) { return 0.5 + offset + 0.2 * (x - 0.5); }, {0.3, 0.7},
+                                {0.3, 0.7}, 12, name);
+  };
+  const std::vector<TriangleSurface> surfaces{patch(0.0, "lower"), patch(0.03, "upper")};
+  InsertionOptions options = coarse();
+  const InsertionResult result = insert(surfaces, options);
+  ASSERT_EQ(result.finer_retries.size(), 1u);
+  EXPECT_NE(result.finer_retries[0].find("could not be healed"), std::string::npos) << result.finer_retries[0];
+  for (const SurfaceInsertion& inserted : result.surfaces) EXPECT_EQ(inserted.resolution, options.resolution / 2);
+  EXPECT_TRUE(result.smoothing.untangled());
+  const std::string report = insertion_report_json(result, Stage::smoothing);
+  EXPECT_NE(report.find("\"finer_retries\""), std::string::npos);
+  EXPECT_NE(report.find("\"resolution\": 0.03125"), std::string::npos) << report;
+
+  options.finer_retries = 0;
+  EXPECT_THROW(insert(surfaces, options), MeshingError);
 }
 
 }  // namespace

@@ -195,6 +195,7 @@ TEST(Smoothing, TriesTheOtherSideWhenOneCannotBeUntangled) {
     EXPECT_NE(insertion_report_json(result, Stage::smoothing).find("\"side_retry\""), std::string::npos);
 
     options.approximation.side_rule = SideRule::positive_only;
+    options.finer_retries = 0;  // a finer l_r would untangle it
     try {
       insert_surfaces(make_cube_meccano(c.box, 0), c.surfaces, options);
       ADD_FAILURE() << "a tangled mesh was returned";
@@ -276,6 +277,7 @@ TEST(Smoothing, FallsBackToTheEquilateralTargetWhereTheMeccanoTargetStalls) {
 
   options.smoothing.fallback_sweeps = 0;
   options.smoothing.max_sweeps = 40;
+  options.finer_retries = 0;
   try {
     insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {&surface, 1}, options);
     ADD_FAILURE() << "the meccano target untangles this disk: the test lost its point";

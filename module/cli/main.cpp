@@ -85,6 +85,10 @@ Options:
                            .mesh  Medit, references named in comment lines (# Triangles ref 7 ...)
   --msh-version V          4.1 (default) or 2.2 for older readers; applies to the .msh outputs that
                            follow it
+  --finer-retries N        a surface whose insertion fails (V_M not within l_r of it, S_M not healed,
+                           or tets next to it still inverted on both sides) is inserted again at half
+                           its l_r, at most N times (default 2; 0: never); the report's finer_retries
+                           and each surface's resolution say what happened
   --max-tets N             refuse to run when the estimated tet count exceeds N (default: 16 GiB at
                            about 280 bytes per tet, 61 million tets): a tiny --resolution fails at once
                            instead of exhausting memory
@@ -163,6 +167,7 @@ struct Options {
   meccano::SmoothingOptions smoothing;
   std::optional<int> threads;
   std::int64_t max_tets = meccano::default_max_tets;
+  int finer_retries = meccano::InsertionOptions{}.finer_retries;
   std::optional<std::string> report;
   std::optional<std::string> histograms;
   bool quiet = false;
@@ -258,6 +263,9 @@ Options parse_options(int argc, char** argv) {
     } else if (arg == "--max-sweeps") {
       options.smoothing.max_sweeps = parse_int(arg, value());
       if (options.smoothing.max_sweeps < 1) throw UsageError("--max-sweeps must be at least 1");
+    } else if (arg == "--finer-retries") {
+      options.finer_retries = parse_int(arg, value());
+      if (options.finer_retries < 0) throw UsageError("--finer-retries must not be negative");
     } else if (arg == "--fallback-sweeps") {
       options.smoothing.fallback_sweeps = parse_int(arg, value());
       if (options.smoothing.fallback_sweeps < 0) throw UsageError("--fallback-sweeps must not be negative");
@@ -336,6 +344,7 @@ int run(const Options& options) {
   insertion.approximation.side_rule = options.side_rule;
   insertion.smoothing = options.smoothing;
   insertion.max_tets = options.max_tets;
+  insertion.finer_retries = options.finer_retries;
   insertion.progress = [&progress](const std::string& line) { progress.say(line); };
   const meccano::InsertionResult result = meccano::insert_surfaces(std::move(mesh), surfaces, insertion);
 

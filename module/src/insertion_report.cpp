@@ -22,7 +22,7 @@ void write_quality(JsonWriter& json, const char* name, const QualitySummary& qua
 }
 
 void write_surface(JsonWriter& json, const SurfaceInsertion& inserted, Stage last_stage) {
-  json.begin_object().key("name").value(inserted.name);
+  json.begin_object().key("name").value(inserted.name).key("resolution").value(inserted.resolution);
   const VolumetricStats& v = inserted.volumetric_stats;
   json.key("volumetric").begin_object();
   json.key("tets").value(v.tets).key("tets_meeting_surface").value(v.tets_intersecting);
@@ -90,8 +90,13 @@ std::string insertion_report_json(const InsertionResult& result, Stage last_stag
     json.key("min_dihedral_deg").value(final_quality.min_dihedral_deg);
     json.key("max_dihedral_deg").value(final_quality.max_dihedral_deg);
   }
-  // Stage seconds are those of the attempt that succeeded; seconds.total counts both.
+  // Stage seconds are those of the attempt that succeeded; seconds.total counts all attempts.
   if (!result.side_retry.empty()) json.key("side_retry").value(result.side_retry);
+  if (!result.finer_retries.empty()) {
+    json.key("finer_retries").begin_array();
+    for (const std::string& failure : result.finer_retries) json.value(failure);
+    json.end_array();
+  }
 
   double stage_seconds[4] = {0, 0, 0, result.smoothing_seconds};
   for (const SurfaceInsertion& inserted : result.surfaces) {

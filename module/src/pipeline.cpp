@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <chrono>
 #include <sstream>
 
@@ -25,6 +26,29 @@ void report(const InsertionOptions& options, const Parts&... parts) {
   options.progress(line.str());
 }
 
+// A MeshingError with the surfaces it concerns, which a retry at a finer l_r may mend.
+class SurfaceFailure : public MeshingError {
+ public:
+  SurfaceFailure(std::vector<int> failing, const std::string& message)
+      : MeshingError(message), surfaces(std::move(failing)) {
+    std::ranges::sort(surfaces);
+    surfaces.erase(std::unique(surfaces.begin(), surfaces.end()), surfaces.end());
+  }
+  std::vector<int> surfaces;  // sorted, each once
+};
+
+// Runs one surface's stage; its MeshingError becomes a SurfaceFailure naming the surface.
+template <class Run>
+auto for_surface(int s, const std::string& name, Run&& run) {
+  try {
+    return run();
+  } catch (const SurfaceFailure&) {
+    throw;
+  } catch (const MeshingError& failure) {
+    throw SurfaceFailure({s}, name + ": " + failure.what());
+  }
+}
+
 // Cheap invariant check at the end of a stage: a failure here is a bug, not bad input.
 void check_stage(const TetMesh& mesh, const char* stage) {
   const auto check = verify_mesh(mesh, {.physical = true});
@@ -32,7 +56,7 @@ void check_stage(const TetMesh& mesh, const char* stage) {
 }
 
 InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options,
-                           std::span<const SideRule> side_rules) {
+                           std::span<const SideRule> side_rules, std::span<const double> resolutions) {
   InsertionResult result;
   result.mesh = std::move(mesh);
   if (static_cast<int>(surfaces.size()) > max_interfaces)
@@ -40,14 +64,18 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
 
   // Step 1: the volumetric approximation of each surface.
   result.surfaces.reserve(surfaces.size());
-  for (const TriangleSurface& surface : surfaces) {
+  for (int index = 0; index < static_cast<int>(surfaces.size()); ++index) {
+    const TriangleSurface& surface = surfaces[index];
     const auto start = std::chrono::steady_clock::now();
     SurfaceInsertion& inserted = result.surfaces.emplace_back();
     inserted.name = surface.name;
+    inserted.resolution = resolutions[index];
     std::vector<TetRegion*> earlier;
-    for (std::size_t s = 0; s + 1 < result.surfaces.size(); ++s) earlier.push_back(&result.surfaces[s].volumetric);
+    for (int s = 0; s < index; ++s) earlier.push_back(&result.surfaces[s].volumetric);
     const TriangleBVH tree(surface);
-    inserted.volumetric = approximate_volume(result.mesh, tree, {options.resolution}, inserted.volumetric_stats, earlier);
+    inserted.volumetric = for_surface(index, surface.name, [&] {
+      return approximate_volume(result.mesh, tree, {inserted.resolution}, inserted.volumetric_stats, earlier);
+    });
     inserted.volumetric_seconds = seconds_since(start);
     const auto& stats = inserted.volumetric_stats;
     report(options, "volumetric ", surface.name, ": ", stats.refinement_passes, " refinement passes, ",
@@ -77,8 +105,10 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
       const auto start = std::chrono::steady_clock::now();
       SurfaceApproximationOptions approximation = options.approximation;
       approximation.side_rule = side_rules[s];
-      inserted.healing_stats = approximate_surface(result.mesh, inserted.volumetric, surfaces[s], trees[s], s,
-                                                   approximation, other_regions(s));
+      inserted.healing_stats = for_surface(s, inserted.name, [&] {
+        return approximate_surface(result.mesh, inserted.volumetric, surfaces[s], trees[s], s, approximation,
+                                   other_regions(s));
+      });
       inserted.approximation_seconds += seconds_since(start);
       healed_any = true;
       const auto& h = inserted.healing_stats;
@@ -95,8 +125,8 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
   for (int s = 0; s < count; ++s) {
     const auto check = check_surface_approximation(result.mesh, result.surfaces[s].volumetric, s);
     if (!check.healed())
-      throw MeshingError("the surface approximation of " + result.surfaces[s].name +
-                         " is disturbed by the other surfaces: " + check.describe());
+      throw SurfaceFailure({s}, "the surface approximation of " + result.surfaces[s].name +
+                                    " is disturbed by the other surfaces: " + check.describe());
   }
   check_stage(result.mesh, "approximation");
   if (options.last_stage == Stage::approximation) return result;
@@ -160,28 +190,67 @@ std::string untangling_failure(const InsertionResult& result, const InsertionOpt
          (options.smoothing.mode == SmoothingMode::band ? " or the whole-mesh mode" : "");
 }
 
-// The side rules of a second attempt: each surface with a node in an inverted tet, if its rule lets
-// it change sides, builds S_M on the other side only. Empty if no surface may change.
-std::vector<SideRule> other_side_rules(const InsertionResult& result, std::span<const SideRule> rules) {
+// The surfaces with an S_M node in an inverted tet, in order.
+std::vector<int> surfaces_next_to_inverted_tets(const InsertionResult& result) {
   const TetMesh& mesh = result.mesh;
   std::vector<int> surface_of(mesh.points.size(), -1);
   for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s)
     for (VertexId v : result.surfaces[s].projection.nodes) surface_of[v] = s;
+  std::vector<std::uint8_t> next(result.surfaces.size(), 0);
+  for (TetId t = 0; t < mesh.num_tets(); ++t)
+    if (is_inverted(mesh, t))
+      for (VertexId v : mesh.tets[t])
+        if (surface_of[v] >= 0) next[surface_of[v]] = 1;
+  std::vector<int> surfaces;
+  for (int s = 0; s < static_cast<int>(next.size()); ++s)
+    if (next[s]) surfaces.push_back(s);
+  return surfaces;
+}
+
+// The side rules of a second attempt: each surface next to an inverted tet, if its rule lets it change
+// sides, builds S_M on the other side only. Empty if no surface may change.
+std::vector<SideRule> other_side_rules(const InsertionResult& result, std::span<const SideRule> rules) {
   std::vector<SideRule> retry(rules.begin(), rules.end());
   bool changed = false;
-  for (TetId t = 0; t < mesh.num_tets(); ++t) {
-    if (!is_inverted(mesh, t)) continue;
-    for (VertexId v : mesh.tets[t]) {
-      const int s = surface_of[v];
-      if (s < 0 || retry[s] != rules[s]) continue;
-      const int side = result.surfaces[s].healing_stats.side;
-      if (rules[s] == SideRule::positive_first || rules[s] == SideRule::negative_first) {
-        retry[s] = side > 0 ? SideRule::negative_only : SideRule::positive_only;
-        changed = true;
-      }
-    }
+  for (int s : surfaces_next_to_inverted_tets(result)) {
+    if (rules[s] != SideRule::positive_first && rules[s] != SideRule::negative_first) continue;
+    retry[s] = result.surfaces[s].healing_stats.side > 0 ? SideRule::negative_only : SideRule::positive_only;
+    changed = true;
   }
   return changed ? retry : std::vector<SideRule>{};
+}
+
+// The surfaces an untangling failure concerns: those next to inverted tets, or all if none is.
+SurfaceFailure untangling_surface_failure(const InsertionResult& result, const std::string& message) {
+  std::vector<int> surfaces = surfaces_next_to_inverted_tets(result);
+  if (surfaces.empty())
+    for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s) surfaces.push_back(s);
+  return SurfaceFailure(std::move(surfaces), message);
+}
+
+// The stages at the given resolutions. A surface whose S_M cannot be untangled on one side of S may be
+// on the other: the stages run again from the input mesh with those surfaces' S_M on their other side,
+// as healing itself does. Throws SurfaceFailure when that fails too.
+InsertionResult insert_on_either_side(const TetMesh& mesh, std::span<const TriangleSurface> surfaces,
+                                      const InsertionOptions& options, std::span<const double> resolutions) {
+  const std::vector<SideRule> rules(surfaces.size(), options.approximation.side_rule);
+  InsertionResult result = run_stages(mesh, surfaces, options, rules, resolutions);
+  if (options.last_stage != Stage::smoothing || surfaces.empty() || result.smoothing.untangled()) return result;
+  const std::string failure = untangling_failure(result, options);
+  const std::vector<SideRule> retry = other_side_rules(result, rules);
+  if (retry.empty()) throw untangling_surface_failure(result, failure);
+  report(options, "retrying with S_M on the other side of the surfaces next to inverted tets (", failure, ")");
+  std::vector<int> failing = surfaces_next_to_inverted_tets(result);
+  try {
+    result = run_stages(mesh, surfaces, options, retry, resolutions);
+  } catch (const SurfaceFailure& other_side) {
+    failing.insert(failing.end(), other_side.surfaces.begin(), other_side.surfaces.end());
+    throw SurfaceFailure(failing, failure + "; on the other side: " + other_side.what());
+  }
+  if (!result.smoothing.untangled())
+    throw untangling_surface_failure(result, failure + "; on the other side: " + untangling_failure(result, options));
+  result.side_retry = failure;
+  return result;
 }
 
 }  // namespace
@@ -209,8 +278,28 @@ void check_tet_estimate(std::int64_t estimated_tets, std::int64_t max_tets, cons
   throw InputError(message.str());
 }
 
-// A surface whose S_M cannot be untangled on one side of S may be on the other: the whole insertion is
-// run again from the input mesh with those surfaces' S_M on their other side, as healing itself does.
+// The failing surfaces and those close enough to them for their S_M to touch (closer than the sum of
+// both l_r, the reach of the two V_M): a finer l_r for one alone would leave the other's S_M in place.
+std::vector<int> surfaces_to_refine(std::span<const TriangleSurface> surfaces, std::span<const double> resolutions,
+                                    std::vector<int> failing) {
+  const std::size_t count = failing.size();
+  for (std::size_t k = 0; k < count; ++k) {
+    const int s = failing[k];
+    const TriangleBVH tree(surfaces[s]);
+    for (int other = 0; other < static_cast<int>(surfaces.size()); ++other) {
+      if (std::ranges::find(failing, other) != failing.end()) continue;
+      const double reach = resolutions[s] + resolutions[other];
+      if (std::ranges::any_of(surfaces[other].points, [&](const Eigen::Vector3d& p) {
+            return tree.closest_point(p).squared_distance < reach * reach;
+          }))
+        failing.push_back(other);
+    }
+  }
+  std::ranges::sort(failing);
+  return failing;
+}
+
+// The insertion at l_r, and where it fails, again with the failing surfaces at half their l_r.
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();
   if (!surfaces.empty()) {
@@ -221,24 +310,36 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
     check_tet_estimate(estimate_tets(mesh.num_tets(), surfaces, options.resolution), options.max_tets, what.str());
   }
   const ThreadCount threads(options.threads);
-  const std::vector<SideRule> rules(surfaces.size(), options.approximation.side_rule);
-  InsertionResult result = run_stages(mesh, surfaces, options, rules);
-  if (options.last_stage == Stage::smoothing && !surfaces.empty() && !result.smoothing.untangled()) {
-    const std::string failure = untangling_failure(result, options);
-    const std::vector<SideRule> retry = other_side_rules(result, rules);
-    if (retry.empty()) throw MeshingError(failure);
-    report(options, "retrying with S_M on the other side of the surfaces next to inverted tets (", failure, ")");
+  std::vector<double> resolutions(surfaces.size(), options.resolution);
+  std::vector<std::string> failures;  // of the attempts so far
+  for (int retry = 0;; ++retry) {
+    std::vector<int> failing;
     try {
-      result = run_stages(std::move(mesh), surfaces, options, retry);
-    } catch (const MeshingError& other_side) {
-      throw MeshingError(failure + "; on the other side: " + other_side.what());
+      InsertionResult result = insert_on_either_side(mesh, surfaces, options, resolutions);
+      result.finer_retries = std::move(failures);
+      result.seconds = seconds_since(pipeline_start);
+      return result;
+    } catch (const SurfaceFailure& failure) {
+      failures.emplace_back(failure.what());
+      failing = failure.surfaces;
     }
-    if (!result.smoothing.untangled())
-      throw MeshingError(failure + "; on the other side: " + untangling_failure(result, options));
-    result.side_retry = failure;
+    auto all_failures = [&] {
+      std::string joined = failures.front();
+      for (std::size_t k = 1; k < failures.size(); ++k) joined += "; then, at a finer l_r: " + failures[k];
+      return joined;
+    };
+    if (retry == options.finer_retries) throw MeshingError(all_failures());
+    std::int64_t estimate = mesh.num_tets();
+    std::ostringstream finer;
+    finer.precision(6);
+    for (int s : surfaces_to_refine(surfaces, resolutions, failing)) {
+      resolutions[s] /= 2.0;
+      finer << (finer.tellp() > 0 ? ", " : "") << surfaces[s].name << " at l_r = " << resolutions[s];
+    }
+    for (std::size_t s = 0; s < surfaces.size(); ++s) estimate += estimate_tets(0, surfaces.subspan(s, 1), resolutions[s]);
+    if (estimate > options.max_tets) throw MeshingError(all_failures() + "; a finer l_r would exceed the tet limit");
+    report(options, "retrying with ", finer.str(), " (", failures.back(), ")");
   }
-  result.seconds = seconds_since(pipeline_start);
-  return result;
 }
 
 MeshGroups output_groups(const InsertionResult& result, Stage last_stage) {

@@ -6,8 +6,9 @@
 // finer than the mesh. The set goes through validate_surfaces (it may intersect itself or touch the
 // box: a rejection with a reason), then insert_surfaces at a random l_r in [1/40, 1/16]. An accepted
 // result must be valid: verify_mesh clean, no inverted tet, every interface node on its surface
-// (within 1e-9 of the box diagonal), and every S_M a disk. Output: one line per case, then a Markdown
-// table of outcomes and reasons.
+// (within 1e-9 of the box diagonal), and every S_M a disk. A valid mesh for which the pipeline had to
+// refine some surface beyond the l_r asked (InsertionOptions::finer_retries) is counted apart. Output:
+// one line per case, then a Markdown table of outcomes and reasons.
 //
 // Usage: stress_surfaces [--seed S] [--cases K] [--first I] [--threads T] [--dump DIR]
 // Case i depends only on (S, i): `--first i --cases 1` reruns it alone; --dump writes each case's surfaces
@@ -203,6 +204,14 @@ std::string defects_of(const meccano::InsertionResult& result, const std::vector
   return out.str();
 }
 
+// The surfaces inserted at a finer l_r than `asked`, with theirs.
+std::string finer_resolutions(const meccano::InsertionResult& result, double asked) {
+  std::ostringstream out;
+  for (const auto& inserted : result.surfaces)
+    if (inserted.resolution < asked) out << inserted.name << " at l_r = 1/" << std::lround(1.0 / inserted.resolution) << ' ';
+  return out.str();
+}
+
 // Writes the case's surfaces as OBJ files and prints the meccano-immerse command that inserts them.
 void dump_case(const std::string& directory, int c, const std::vector<TriangleSurface>& surfaces, double resolution) {
   std::ostringstream command;
@@ -225,10 +234,11 @@ std::string one_decimal(double value) {
   return out.str();
 }
 
-enum class Outcome { accepted_ok, accepted_invalid, rejected, failed };
+enum class Outcome { accepted_ok, accepted_ok_finer, accepted_invalid, rejected, failed };
 const char* outcome_name(Outcome outcome) {
   switch (outcome) {
     case Outcome::accepted_ok: return "accepted, valid mesh";
+    case Outcome::accepted_ok_finer: return "accepted, valid mesh at a finer l_r";
     case Outcome::accepted_invalid: return "accepted, INVALID mesh";
     case Outcome::rejected: return "rejected by validation";
     case Outcome::failed: return "failed by the method";
@@ -280,7 +290,12 @@ int main(int argc, char** argv) {
         const meccano::InsertionResult result =
             meccano::insert_surfaces(meccano::make_cube_meccano(box, 0), surfaces, insertion);
         detail = defects_of(result, surfaces);
-        if (!detail.empty()) outcome = Outcome::accepted_invalid;
+        if (!detail.empty()) {
+          outcome = Outcome::accepted_invalid;
+        } else if (!result.finer_retries.empty()) {
+          outcome = Outcome::accepted_ok_finer;
+          detail = finer_resolutions(result, resolution) + "after: " + result.finer_retries.front();
+        }
       } catch (const std::exception& error) {  // MeshingError, or anything the method should not throw
         outcome = Outcome::failed;
         detail = error.what();

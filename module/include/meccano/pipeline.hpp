@@ -9,6 +9,10 @@
 //             (smoothing.hpp). If tets stay inverted, the insertion is run again with the S_M of the
 //             surfaces next to them on the other side of S (when the side rule allows it); a mesh that
 //             stays tangled is an error, never a result.
+//          A surface whose insertion still fails (V_M cannot be grown within l_r of S, S_M cannot be
+//          healed, or the tets next to its S_M stay tangled on both sides) is inserted again, from the
+//          input mesh, at half its l_r, at most options.finer_retries times; l_r is an upper bound on the
+//          edges near S, so a finer one still honours it. result.finer_retries says why.
 //          The surfaces are taken one after the other; a later surface's refinement keeps the earlier
 //          surfaces' regions in step (bisection does not change a region's point set).
 // Output   the refined mesh, each surface's V_M, per-stage statistics and timings; surface_interfaces()
@@ -61,11 +65,13 @@ struct InsertionOptions {
   SmoothingOptions smoothing;                 // SUS mode, target and limits
   int threads = 0;                            // OpenMP threads for this call; 0 = OpenMP's default
   std::int64_t max_tets = default_max_tets;    // refuse when estimate_tets exceeds it
+  int finer_retries = 2;                      // times a failing surface may be retried at half its l_r
   std::function<void(const std::string&)> progress;  // one line per stage, with counts
 };
 
 struct SurfaceInsertion {
   std::string name;
+  double resolution = 0.0;  // the l_r it was inserted at: options.resolution, or less after finer retries
   TetRegion volumetric;  // V_M, one flag per tet of the final mesh
   VolumetricStats volumetric_stats;
   double volumetric_seconds = 0.0;
@@ -84,13 +90,14 @@ struct InsertionResult {
   QualitySummary quality_after_smoothing;
   double seconds = 0.0;                     // the whole insertion
   std::string side_retry;  // why the insertion was run again with S_M on the other side (empty if not)
+  std::vector<std::string> finer_retries;  // why it was run again with finer l_r for some surfaces, in order
 };
 
 // The report of an insertion as a JSON document: tets, nodes, inverted (after smoothing), quality
 // before and after smoothing (meccano and equilateral min/mean/std, inverted, dihedral range),
 // min_dihedral_deg and max_dihedral_deg of the result, seconds per stage and in total, and per surface
-// the statistics of every stage, and side_retry if the insertion had to be run again (the stage seconds
-// are then those of the second run). Keys of stages not run are left out.
+// the statistics of every stage and its resolution, side_retry and finer_retries if the insertion had to
+// be run again (the stage seconds are then those of the last run). Keys of stages not run are left out.
 std::string insertion_report_json(const InsertionResult& result, Stage last_stage);
 
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options);

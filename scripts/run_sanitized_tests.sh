@@ -36,12 +36,12 @@ export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 unit='SurfaceIo|SurfaceWeld|MshVersions|SurfaceTopology|GeometryChecks|Geometry\.|Bisection|CubeMeccano'
 unit+='|BallCheck|GrowIntoBall|VolumetricApproximation|SurfaceApproximation\.|Parameterization|Projection\.'
 unit+='|Distortion|QualitySummary|DihedralAngles|HistogramCsv|JsonWriter|MeshIo|SurfaceInterfaces|CliTest'
-unit+='|Smoothing\.(UntanglesAScrambled|UntanglesTowardsTheEquilateral)'
+unit+='|Smoothing\.(UntanglesAScrambled|UntanglesTowardsTheEquilateral|FallsBackToTheEquilateral)|InsertionOptions\.SurfacesTooClose'
 coarse='(VolumetricOnSurface|SurfaceApproximationOn|ProjectionOn|SmoothingOn)\..*unit_cube_lr16$'
 excluded='ReferenceGmsh'
 if $quick; then
   excluded+='|CliTest\.(FullPipeline|WritesEveryFormat)|SurfaceInterfaces\.(TwoStacked|TheNegativeSide)'
-  excluded+='|Projection\.HausdorffDistanceShrinks|PerturbedSurfacesGiveBallsToo|Smoothing\.UntanglesTowardsTheEquilateral'
+  excluded+='|Projection\.HausdorffDistanceShrinks|PerturbedSurfacesGiveBallsToo|Smoothing\.(UntanglesTowardsTheEquilateral|FallsBack)'
   excluded+='|Geometry\.TriangleTetrahedronNeverMisses|SmoothingOn\..*/(spherical_cap|saddle|stacked_pair|tilted_plane|strongly_curved_sheet|paper_like|perturbed_paper_like)_'
 fi
 ctest --test-dir "$build" -j"$jobs" --output-on-failure -R "^(${unit})|${coarse}" -E "$excluded"

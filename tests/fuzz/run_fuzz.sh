@@ -5,6 +5,9 @@
 # Usage: tests/fuzz/run_fuzz.sh [--parallel] [seconds per target, default 60] [build-dir, default build-fuzz/ in the checkout]
 #
 # --parallel runs all targets at once (for long unattended runs) instead of one after the other.
+# FUZZ_UNIT_TIMEOUT (seconds, default 10) is libFuzzer's -timeout, which counts wall time: a fuzzer
+# starved of CPU (niced beside other work) can pass 10 s on an input that takes milliseconds, so raise
+# it for long runs on a busy machine, and replay a reported timeout before believing it.
 #
 # New inputs that libFuzzer finds go to <build-dir>/corpus/<target>/ (the seeds under
 # tests/fuzz/corpus/ stay as they are); a crashing input is saved as <build-dir>/artifacts/<target>-*
@@ -35,7 +38,7 @@ fuzz_target() {
   mkdir -p "$build/corpus/$target"
   local log="$build/$target.log"
   if ! "$build/tests/fuzz/$target" -max_total_time="$seconds" -max_len="$max_len" -rss_limit_mb=2048 \
-       -timeout=10 -print_final_stats=1 -artifact_prefix="$build/artifacts/$target-" \
+       -timeout="${FUZZ_UNIT_TIMEOUT:-10}" -print_final_stats=1 -artifact_prefix="$build/artifacts/$target-" \
        "$build/corpus/$target" "tests/fuzz/corpus/$target" > "$log" 2>&1; then
     tail -40 "$log"
     echo "fuzz: $target FAILED (log $log, input in $build/artifacts/)"

@@ -328,7 +328,9 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
       for (std::size_t k = 1; k < failures.size(); ++k) joined += "; then, at a finer l_r: " + failures[k];
       return joined;
     };
-    if (retry == options.finer_retries) throw MeshingError(all_failures());
+    if (retry == options.finer_retries)
+      throw MeshingError(all_failures() + "; more finer retries (--finer-retries, InsertionOptions::finer_retries; " +
+                         std::to_string(options.finer_retries) + " here) may succeed");
     std::int64_t estimate = mesh.num_tets();
     std::ostringstream finer;
     finer.precision(6);

@@ -207,12 +207,13 @@ std::vector<int> surfaces_next_to_inverted_tets(const InsertionResult& result) {
   return surfaces;
 }
 
-// The side rules of a second attempt: each surface next to an inverted tet, if its rule lets it change
-// sides, builds S_M on the other side only. Empty if no surface may change.
-std::vector<SideRule> other_side_rules(const InsertionResult& result, std::span<const SideRule> rules) {
+// The side rules of a second attempt: each surface next to an inverted tet (`next`), if its rule lets
+// it change sides, builds S_M on the other side only. Empty if no surface may change.
+std::vector<SideRule> other_side_rules(const InsertionResult& result, std::span<const int> next,
+                                       std::span<const SideRule> rules) {
   std::vector<SideRule> retry(rules.begin(), rules.end());
   bool changed = false;
-  for (int s : surfaces_next_to_inverted_tets(result)) {
+  for (int s : next) {
     if (rules[s] != SideRule::positive_first && rules[s] != SideRule::negative_first) continue;
     retry[s] = result.surfaces[s].healing_stats.side > 0 ? SideRule::negative_only : SideRule::positive_only;
     changed = true;
@@ -220,12 +221,11 @@ std::vector<SideRule> other_side_rules(const InsertionResult& result, std::span<
   return changed ? retry : std::vector<SideRule>{};
 }
 
-// The surfaces an untangling failure concerns: those next to inverted tets, or all if none is.
-SurfaceFailure untangling_surface_failure(const InsertionResult& result, const std::string& message) {
-  std::vector<int> surfaces = surfaces_next_to_inverted_tets(result);
-  if (surfaces.empty())
-    for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s) surfaces.push_back(s);
-  return SurfaceFailure(std::move(surfaces), message);
+// An untangling failure concerns the surfaces next to inverted tets (`next`), or all if none is.
+SurfaceFailure untangling_surface_failure(std::vector<int> next, int count, const std::string& message) {
+  if (next.empty())
+    for (int s = 0; s < count; ++s) next.push_back(s);
+  return SurfaceFailure(std::move(next), message);
 }
 
 // The stages at the given resolutions. A surface whose S_M cannot be untangled on one side of S may be
@@ -233,22 +233,24 @@ SurfaceFailure untangling_surface_failure(const InsertionResult& result, const s
 // as healing itself does. Throws SurfaceFailure when that fails too.
 InsertionResult insert_on_either_side(const TetMesh& mesh, std::span<const TriangleSurface> surfaces,
                                       const InsertionOptions& options, std::span<const double> resolutions) {
+  const int count = static_cast<int>(surfaces.size());
   const std::vector<SideRule> rules(surfaces.size(), options.approximation.side_rule);
   InsertionResult result = run_stages(mesh, surfaces, options, rules, resolutions);
   if (options.last_stage != Stage::smoothing || surfaces.empty() || result.smoothing.untangled()) return result;
   const std::string failure = untangling_failure(result, options);
-  const std::vector<SideRule> retry = other_side_rules(result, rules);
-  if (retry.empty()) throw untangling_surface_failure(result, failure);
+  std::vector<int> next = surfaces_next_to_inverted_tets(result);
+  const std::vector<SideRule> retry = other_side_rules(result, next, rules);
+  if (retry.empty()) throw untangling_surface_failure(std::move(next), count, failure);
   report(options, "retrying with S_M on the other side of the surfaces next to inverted tets (", failure, ")");
-  std::vector<int> failing = surfaces_next_to_inverted_tets(result);
   try {
     result = run_stages(mesh, surfaces, options, retry, resolutions);
   } catch (const SurfaceFailure& other_side) {
-    failing.insert(failing.end(), other_side.surfaces.begin(), other_side.surfaces.end());
-    throw SurfaceFailure(failing, failure + "; on the other side: " + other_side.what());
+    next.insert(next.end(), other_side.surfaces.begin(), other_side.surfaces.end());
+    throw SurfaceFailure(std::move(next), failure + "; on the other side: " + other_side.what());
   }
   if (!result.smoothing.untangled())
-    throw untangling_surface_failure(result, failure + "; on the other side: " + untangling_failure(result, options));
+    throw untangling_surface_failure(surfaces_next_to_inverted_tets(result), count,
+                                     failure + "; on the other side: " + untangling_failure(result, options));
   result.side_retry = failure;
   return result;
 }

@@ -19,7 +19,9 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
@@ -41,6 +43,26 @@ class CliTest : public testing::ScratchDirectoryTest {
     out.precision(17);
     for (const auto& p : surface.points) out << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
     for (const auto& t : surface.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    return path(name);
+  }
+
+  // The surfaces as one GOCAD TSurf object, a TFACE each, followed by `extra` lines. No coordinate
+  // system: the unit cube is not in metres.
+  std::string write_tsurf(const std::string& name, const std::vector<TriangleSurface>& surfaces,
+                          const std::string& extra = "") const {
+    std::ofstream out(path(name));
+    out.precision(17);
+    out << "GOCAD TSurf 1\nHEADER {\nname:" << name << "\n}\n";
+    std::size_t first_id = 1;
+    for (const auto& surface : surfaces) {
+      out << "TFACE\n";
+      for (std::size_t v = 0; v < surface.points.size(); ++v)
+        out << "VRTX " << first_id + v << ' ' << surface.points[v].transpose() << '\n';
+      for (const auto& t : surface.triangles)
+        out << "TRGL " << first_id + t[0] << ' ' << first_id + t[1] << ' ' << first_id + t[2] << '\n';
+      first_id += surface.points.size();
+    }
+    out << extra << "END\n";
     return path(name);
   }
 
@@ -83,7 +105,8 @@ TEST_F(CliTest, HelpExitsZeroWithExamples) {
   EXPECT_EQ(run.status, 0);
   EXPECT_NE(run.output.find("--box X0,Y0,Z0,X1,Y1,Z1"), std::string::npos);
   EXPECT_NE(run.output.find("Examples:"), std::string::npos);
-  for (const char* text : {"--msh-version V", ".vtu", ".mesh", "--output fault.vtu"})
+  for (const char* text : {"--msh-version V", ".vtu", ".mesh", "--output fault.vtu", ".ts GOCAD TSurf", "ZPOSITIVE",
+                           "--weld-tolerance D", "--split-parts"})
     EXPECT_NE(run.output.find(text), std::string::npos) << text;
 }
 
@@ -119,6 +142,11 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --finer-retries -2 --output " + path("a.msh"),
        "--finer-retries must not be negative"},
       {"--box 0,0,0,1,1,1 --histograms h.csv --output " + path("a.msh"), "need at least one --surface"},
+      {"--box 0,0,0,1,1,1 --surface s.ts --resolution 0.1 --weld-tolerance -1 --output " + path("a.msh"),
+       "--weld-tolerance must not be negative"},
+      {"--box 0,0,0,1,1,1 --surface s.ts --resolution 0.1 --weld-tolerance x --output " + path("a.msh"),
+       "--weld-tolerance: 'x' is not a finite number"},
+      {"--box 0,0,0,1,1,1 --split-parts --output " + path("a.msh"), "--split-parts need at least one --surface"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --stage projection --histograms h.csv --output " +
            path("a.msh"),
        "needs --stage smoothing"},
@@ -294,6 +322,84 @@ TEST_F(CliTest, BadSurfacesFailWithTheirOwnMessageAndWriteNothing) {
   EXPECT_EQ(missing.status, 1);
   EXPECT_NE(missing.output.find("none.obj"), std::string::npos) << missing.output;
   EXPECT_TRUE(only_inputs_in_directory(5));
+}
+
+// A real fault (UTM metres) in a box 10 % of its largest extent larger on every side, at l_r = that
+// extent / 20.
+TEST_F(CliTest, TsurfFaultAtTheVolumetricStage) {
+  const fs::path fault = fs::path(MECCANO_FAULTS_DIR) / "PNRA-CRSF-YUHA-Shell_Beds_fault-CFM5_1000m.ts";
+  if (!fs::exists(fault)) GTEST_SKIP() << "no fault data at " << fault << " (shared/data/faults beside the checkout)";
+  const TriangleSurface surface = read_surface(fault.string());
+  Eigen::Vector3d lo = surface.points[0], hi = surface.points[0];
+  for (const auto& p : surface.points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double extent = (hi - lo).maxCoeff();
+  lo.array() -= 0.1 * extent;
+  hi.array() += 0.1 * extent;
+  std::ostringstream box;
+  box.precision(17);
+  box << lo.x() << ',' << lo.y() << ',' << lo.z() << ',' << hi.x() << ',' << hi.y() << ',' << hi.z();
+  const CliRun run = run_cli("--box " + box.str() + " --surface " + fault.string() + ":shell_beds --resolution " +
+                             std::to_string(extent / 20) + " --stage volumetric --output " + path("fault.msh"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("surface shell_beds: " + fault.string() + ", 317 triangles, 182 points\n"),
+            std::string::npos)
+      << run.output;
+  const auto sizes = group_sizes(path("fault.msh"));
+  ASSERT_TRUE(sizes.count("volumetric_shell_beds")) << run.output;
+  EXPECT_GT(sizes.at("volumetric_shell_beds"), 0u);
+  EXPECT_LT(sizes.at("volumetric_shell_beds"), sizes.at("domain"));
+}
+
+// One TSurf file holding both surfaces of the stacked pair, in two TFACEs that share no edge.
+TEST_F(CliTest, SplitPartsInsertsEachPartOfATsurfAsItsOwnSurface) {
+  const std::string file = write_tsurf("pair.ts", testing::stacked_pair(8));
+  const std::string arguments = "--box 0,0,0,1,1,1 --surface " + file + ":pair --resolution 0.1 --stage approximation ";
+  const CliRun refused = run_cli(arguments + "--output " + path("sm.msh"));
+  EXPECT_EQ(refused.status, 1) << refused.output;
+  for (const char* text : {"pair.ts: 2 parts", "part 1, 128 triangles in TFACE 1 (line 5) of object 'pair.ts'",
+                           "part 2, 128 triangles in TFACE 2 (line 215) of object 'pair.ts'", "--split-parts"})
+    EXPECT_NE(refused.output.find(text), std::string::npos) << text << "\n" << refused.output;
+  EXPECT_FALSE(fs::exists(path("sm.msh")));
+
+  const CliRun run = run_cli(arguments + "--split-parts --output " + path("sm.msh"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  for (const char* text : {"surface pair: ", "pair.ts, 2 parts\n", "surface pair_1: part 1 of ",
+                           "surface pair_2: part 2 of ", "approximation pair_1: side", "approximation pair_2: side"})
+    EXPECT_NE(run.output.find(text), std::string::npos) << text << "\n" << run.output;
+  const auto sizes = group_sizes(path("sm.msh"));
+  for (const char* name : {"interface_pair_1", "interface_pair_2"})
+    EXPECT_GT(sizes.count(name) ? sizes.at(name) : 0u, 0u) << name;
+  EXPECT_EQ(sizes.count("interface_pair"), 0u);
+}
+
+// A vertex 1e-7 from another (the default TSurf weld of an unknown unit: 1e-6 of the diagonal) in a
+// copy of the first triangle, and a triangle with a repeated vertex: the progress line counts them,
+// and the surface is valid once they are dropped. --weld-tolerance 0 keeps the copy, which the
+// validation refuses.
+TEST_F(CliTest, TsurfWeldingIsCountedInTheProgressLine) {
+  const TriangleSurface patch = testing::paper_like_patch(6);
+  const Eigen::Vector3d near =
+      patch.points[static_cast<std::size_t>(patch.triangles[0][0])] + Eigen::Vector3d(1e-7, 0, 0);
+  std::ostringstream extra;
+  extra.precision(17);
+  extra << "VRTX 1000 " << near.transpose() << "\nTRGL 1000 " << patch.triangles[0][1] + 1 << ' '
+        << patch.triangles[0][2] + 1 << "\nTRGL 1 1 2\n";
+  const std::string file = write_tsurf("patch.ts", {patch}, extra.str());
+  const std::string arguments = "--box 0,0,0,1,1,1 --surface " + file + ":patch --resolution 0.1 --stage volumetric ";
+  const CliRun run = run_cli(arguments + "--output " + path("vm.msh"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find(", 72 triangles, 49 points, 1 vertex welded, 1 degenerate triangle dropped, 1 duplicate "
+                            "triangle dropped\n"),
+            std::string::npos)
+      << run.output;
+  const CliRun unwelded = run_cli(arguments + "--weld-tolerance 0 --output " + path("vm.msh"));
+  EXPECT_EQ(unwelded.status, 1) << unwelded.output;
+  EXPECT_NE(unwelded.output.find(", 73 triangles, 50 points, 1 degenerate triangle dropped\n"), std::string::npos)
+      << unwelded.output;
+  EXPECT_NE(unwelded.output.find("patch.ts: non-manifold edge"), std::string::npos) << unwelded.output;
 }
 
 std::string file_text(const std::string& file) {

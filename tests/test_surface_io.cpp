@@ -1,4 +1,4 @@
-// Surface readers: round trips through every supported format, every error path, and welding.
+// Surface readers: round trips through every supported format, every error path, welding and parts.
 #include <meccano/error.hpp>
 #include <meccano/surface.hpp>
 
@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -18,6 +19,8 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace {
 
@@ -416,14 +419,14 @@ TEST_F(SurfaceIo, MissingFile) {
 }
 
 TEST_F(SurfaceIo, EmptyFile) {
-  for (const char* name : {"empty.obj", "empty.stl", "empty.off", "empty.msh"})
+  for (const char* name : {"empty.obj", "empty.stl", "empty.off", "empty.msh", "empty.ts"})
     EXPECT_THAT(read_error(name, ""), HasSubstr(std::string(name) + ": empty file"));
 }
 
 TEST_F(SurfaceIo, UnknownExtensionListsTheSupportedOnes) {
   const std::string message = read_error("mesh.ply", "ply\n");
   EXPECT_THAT(message, HasSubstr("mesh.ply: unsupported surface format '.ply'"));
-  EXPECT_THAT(message, HasSubstr(".obj, .stl, .off, .msh"));
+  EXPECT_THAT(message, HasSubstr("(supported: .obj, .stl, .off, .msh, .ts)"));
 }
 
 TEST_F(SurfaceIo, NoTriangles) {
@@ -612,6 +615,265 @@ TEST_F(SurfaceIo, MshTruncatedBinary) {
   const std::string bytes = msh41_bytes(grid_patch(), true);
   const std::string cut = bytes.substr(0, bytes.find("$EndElements") - 40);
   EXPECT_THAT(read_error("cut.msh", cut), HasSubstr("cut.msh: unexpected end of file"));
+}
+
+// ---------------------------------------------------------------------------------------- TSurf
+
+// The real faults of shared/data/faults (README.md there): triangle counts and extents from its table
+// (km, rounded to 0.1, one of them rounded up from x.45), vertex counts read independently of this reader.
+TEST(SurfaceIoFaults, EverySharedFaultReadsWithItsCountsAndExtent) {
+  const fs::path dir = MECCANO_FAULTS_DIR;
+  if (!fs::is_directory(dir)) GTEST_SKIP() << "no fault data at " << dir << " (shared/data/faults beside the checkout)";
+  struct Fault {
+    const char* file;
+    std::size_t triangles, vertices;
+    std::array<double, 6> km;  // x, y, z ranges: min, max
+  };
+  const Fault faults[] = {
+      {"CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts", 1161, 664, {182.5, 224.6, 3853.2, 3911.8, -7.2, 0.9}},
+      {"MJVA-HSLZ-SBMT-Pipes_Canyon_fault_north_extension-CFM5_1000m.ts", 584, 322,
+       {518.2, 526.9, 3795.2, 3802.8, -10.4, 1.6}},
+      {"PNRA-CRSF-YUHA-Shell_Beds_fault-CFM5_1000m.ts", 317, 182, {606.0, 609.5, 3618.3, 3624.3, -7.1, 0.1}},
+      {"PNRA-SJFZ-SJCV-Claremont_fault-CFM4_1000m.ts", 2625, 1383, {482.6, 508.8, 3733.0, 3759.9, -18.8, 0.7}},
+      {"PNRA-SJFZ-SJCV-San_Jacinto_Claremont_fault_east-CFM4_1000m.ts", 1258, 680,
+       {483.1, 490.8, 3753.3, 3760.5, -17.5, 0.7}},
+      {"WTRA-SFFS-ANCP-Malibu_Coast_fault_west_steep_alt2-CFM5_1000m.ts", 1022, 559,
+       {289.1, 321.3, 3762.1, 3771.3, -13.4, 0.0}},
+      {"WTRA-SFFS-SRSM-Western_Santa_Cruz_Island_fault_trim-CFM5_1000m.ts", 788, 476,
+       {166.4, 227.7, 3771.8, 3792.0, -8.0, -0.1}},
+      {"WTRA-SMFZ-SMDE-Sierra_Madre_fault_low_dip-CFM4_1000m.ts", 894, 482, {423.5, 430.1, 3776.5, 3787.3, -14.8, 0.7}},
+  };
+  for (const Fault& fault : faults) {
+    SCOPED_TRACE(fault.file);
+    meccano::SurfaceReadReport report;
+    const TriangleSurface surface = meccano::read_surface((dir / fault.file).string(), {}, &report);
+    EXPECT_EQ(surface.triangles.size(), fault.triangles);
+    EXPECT_EQ(surface.points.size(), fault.vertices);
+    EXPECT_EQ(report.welded_vertices + report.degenerate_triangles + report.duplicate_triangles, 0);
+    Eigen::Vector3d lo = surface.points[0], hi = surface.points[0];
+    for (const auto& p : surface.points) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_NEAR(lo[axis] / 1000, fault.km[2 * axis], 0.06) << "axis " << axis;
+      EXPECT_NEAR(hi[axis] / 1000, fault.km[2 * axis + 1], 0.06) << "axis " << axis;
+    }
+  }
+}
+
+// The lines before the geometry, numbered: a HEADER block, a coordinate system, properties, a comment.
+const std::string kTsurfHeader =
+    "GOCAD TSurf 1\n"                                            // 1
+    "HEADER {\n"                                                 // 2
+    "name: square fault\n"                                       // 3
+    "*solid*color:#87ceeb\n"                                     // 4
+    "}\n"                                                        // 5
+    "GOCAD_ORIGINAL_COORDINATE_SYSTEM\n"                         // 6
+    "NAME Default\n"                                             // 7
+    "AXIS_NAME \"X\" \"Y\" \"Z\"\n"                              // 8
+    "AXIS_UNIT \"m\" \"m\" \"m\"\n"                              // 9
+    "ZPOSITIVE Depth\n"                                          // 10
+    "END_ORIGINAL_COORDINATE_SYSTEM\n"                           // 11
+    "PROPERTIES a b\n"                                           // 12
+    "PROPERTY_CLASS_HEADER a {\n"                                // 13
+    "low_clip:0\n"                                               // 14
+    "}\n"                                                        // 15
+    "# a comment\n";                                             // 16
+
+// A square's two triangles in TFACE 1 (vertices 10, 20, 30, 40) and, on the edge 20-30, a triangle
+// in TFACE 2 (vertex 50 and atoms of 20 and 30), then the same triangle reversed.
+TEST_F(SurfaceIo, TsurfWithPropertiesAtomsAndTwoTfacesSharingAnEdgeIsOneSurface) {
+  const std::string text = kTsurfHeader +
+                           "TFACE\n"                                        // 17
+                           "PVRTX 10 0 0 100 1.5 2.5\n"                     // 18
+                           "PVRTX 20 10 0 100 1.5 2.5\n"                    // 19
+                           "VRTX 30 10 10 100 # corner\n"                   // 20
+                           "VRTX 40 0 10 100\n"                             // 21
+                           "TRGL 10 20 30\n"                                // 22
+                           "TRGL 10 30 40\n"                                // 23
+                           "BSTONE 10\n"                                    // 24
+                           "BORDER 41 10 20\n"                              // 25
+                           "TFACE\n"                                        // 26
+                           "PATOM 60 20 7 8\n"                              // 27
+                           "ATOM 70 30\n"                                   // 28
+                           "ATOM 80 70\n"                                   // 29
+                           "VRTX 50 20 5 100\n"                             // 30
+                           "TRGL 60 50 70\n"                                // 31
+                           "TRGL 50 60 80\n"                                // 32 (31 reversed)
+                           "END\n";
+  meccano::SurfaceReadReport report;
+  const std::string path = write("square.ts", text);
+  const TriangleSurface read = meccano::read_surface(path, {}, &report);
+  EXPECT_EQ(read.name, "square");
+  EXPECT_EQ(read.source, path);
+  ASSERT_EQ(read.triangles.size(), 3U);
+  ASSERT_EQ(read.points.size(), 5U);
+  EXPECT_EQ(report.duplicate_triangles, 1);
+  EXPECT_EQ(report.welded_vertices + report.degenerate_triangles, 0);
+  // The atoms are the vertices they name; z as in the file (ZPOSITIVE Depth is not applied).
+  EXPECT_EQ(corner(read, 2, 0), Eigen::Vector3d(10, 0, 100));
+  EXPECT_EQ(corner(read, 2, 1), Eigen::Vector3d(20, 5, 100));
+  EXPECT_EQ(corner(read, 2, 2), Eigen::Vector3d(10, 10, 100));
+  EXPECT_EQ(read.triangles[2][0], read.triangles[0][1]);
+  EXPECT_EQ(read.triangles[2][2], read.triangles[0][2]);
+  EXPECT_LT((area_vector(read) - Eigen::Vector3d(0, 0, 150)).norm(), 1e-12);  // the file's orientation
+  EXPECT_EQ(meccano::read_tsurf(path).triangles.size(), 3U);
+  EXPECT_EQ(meccano::read_surface(write("UPPER.TS", text)).triangles.size(), 3U);
+}
+
+// Two triangles apart in TFACE 1, one in TFACE 2 joined by an edge to the second of TFACE 1, and one
+// of a second object (its own ids, no name) alone: parts {1}, {2, 3}, {4} in file order.
+const std::string kThreePartTsurf =
+    "GOCAD TSurf 1\n"           // 1
+    "HEADER {name:faults}\n"    // 2
+    "TFACE\n"                   // 3
+    "VRTX 1 0 0 0\n"            // 4
+    "VRTX 2 1 0 0\n"            // 5
+    "VRTX 3 0 1 0\n"            // 6
+    "VRTX 4 5 0 0\n"            // 7
+    "VRTX 5 6 0 0\n"            // 8
+    "VRTX 6 5 1 0\n"            // 9
+    "TRGL 1 2 3\n"              // 10
+    "TRGL 4 5 6\n"              // 11
+    "TFACE\n"                   // 12
+    "VRTX 7 6 1 0\n"            // 13
+    "TRGL 6 5 7\n"              // 14
+    "END\n"                     // 15
+    "GOCAD TSurf 1\n"           // 16
+    "TFACE\n"                   // 17
+    "VRTX 1 0 0 9\n"            // 18
+    "VRTX 2 1 0 9\n"            // 19
+    "VRTX 3 0 1 9\n"            // 20
+    "TRGL 1 2 3\n"              // 21
+    "END\n";
+
+TEST_F(SurfaceIo, TsurfOfSeveralPartsIsRefusedNamingEachPart) {
+  const std::string message = read_error("parts.ts", kThreePartTsurf);
+  EXPECT_THAT(message,
+              HasSubstr("parts.ts: 3 parts (triangles joined through shared edges) where one surface is expected"));
+  EXPECT_THAT(message, HasSubstr("part 1, 1 triangle in TFACE 1 (line 3) of object 'faults';"));
+  EXPECT_THAT(message, HasSubstr("part 2, 2 triangles in TFACE 1 (line 3) of object 'faults' and TFACE 2 (line 12) of "
+                                 "object 'faults';"));
+  EXPECT_THAT(message, HasSubstr("part 3, 1 triangle in TFACE 3 (line 17) of object 2;"));
+  EXPECT_THAT(message, HasSubstr("--split-parts"));
+  EXPECT_THAT(input_error([&] { meccano::read_tsurf((dir_ / "parts.ts").string()); }), HasSubstr("3 parts"));
+}
+
+TEST_F(SurfaceIo, SurfacePartsAreNamedInFileOrder) {
+  const std::vector<TriangleSurface> parts = meccano::read_surface_parts(write("faults.ts", kThreePartTsurf));
+  ASSERT_EQ(parts.size(), 3U);
+  EXPECT_EQ(parts[0].name, "faults_1");
+  EXPECT_EQ(parts[1].name, "faults_2");
+  EXPECT_EQ(parts[2].name, "faults_3");
+  EXPECT_EQ(parts[1].source, (dir_ / "faults.ts").string());
+  ASSERT_EQ(parts[0].triangles.size(), 1U);
+  ASSERT_EQ(parts[1].triangles.size(), 2U);
+  ASSERT_EQ(parts[2].triangles.size(), 1U);
+  EXPECT_EQ(parts[1].points.size(), 4U);
+  EXPECT_EQ(corner(parts[1], 1, 2), Eigen::Vector3d(6, 1, 0));
+  EXPECT_EQ(corner(parts[2], 0, 0), Eigen::Vector3d(0, 0, 9));
+  // Any format: the parts of an OBJ file too.
+  const auto obj_parts = meccano::read_surface_parts(
+      write("two.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 5 5 5\nv 6 5 5\nv 5 6 5\nf 1 2 3\nf 5 6 7\nf 4 3 2\n"));
+  ASSERT_EQ(obj_parts.size(), 2U);  // the third triangle shares an edge with the first
+  EXPECT_EQ(obj_parts[0].triangles.size(), 2U);
+  EXPECT_EQ(obj_parts[0].points.size(), 4U);
+  EXPECT_EQ(obj_parts[1].name, "two_2");
+  EXPECT_EQ(corner(obj_parts[1], 0, 2), Eigen::Vector3d(5, 6, 5));
+}
+
+// 0.4 m apart: welded at 1 m. The triangle between them collapses and is dropped; one further away
+// (2 m) is not welded.
+std::string near_coincident_tsurf(const std::string& unit, double scale) {
+  auto vertex = [scale](int id, double x, double y) {
+    return "VRTX " + std::to_string(id) + " " + number(x * scale) + " " + number(y * scale) + " 0\n";
+  };
+  return "GOCAD TSurf 1\nGOCAD_ORIGINAL_COORDINATE_SYSTEM\nAXIS_UNIT " + unit + " " + unit + " " + unit +
+         "\nEND_ORIGINAL_COORDINATE_SYSTEM\nTFACE\n" + vertex(1, 0, 0) + vertex(2, 100, 0) + vertex(3, 0, 100) +
+         vertex(4, 100.4, 0) + vertex(5, 100, 100) + vertex(6, 102, 100) +
+         "TRGL 1 2 3\nTRGL 3 4 5\nTRGL 2 4 5\nTRGL 4 6 5\nEND\n";
+}
+
+TEST_F(SurfaceIo, TsurfWeldsWithinOneMetreInItsUnitAndDropsCollapsedTriangles) {
+  for (const auto& [unit, scale] : {std::pair{"\"m\"", 1.0}, std::pair{"km", 0.001}, std::pair{"ft", 1 / 0.3048}}) {
+    SCOPED_TRACE(unit);
+    meccano::SurfaceReadReport report;
+    const std::string path = write("near.ts", near_coincident_tsurf(unit, scale));
+    const TriangleSurface read = meccano::read_surface(path, {}, &report);
+    EXPECT_EQ(report.welded_vertices, 1);
+    EXPECT_EQ(report.degenerate_triangles, 1);
+    EXPECT_EQ(report.duplicate_triangles, 0);
+    ASSERT_EQ(read.triangles.size(), 3U);
+    EXPECT_EQ(read.points.size(), 5U);
+    EXPECT_EQ(read.triangles[1][1], read.triangles[0][1]);  // vertex 4 is vertex 2
+  }
+  // An unknown unit: 1e-6 of the diagonal (1.4e-4), which keeps them apart, and the triangles in two
+  // parts.
+  meccano::SurfaceReadReport report;
+  const std::string unknown = write("unknown.ts", near_coincident_tsurf("furlong", 1.0));
+  EXPECT_EQ(meccano::read_surface_parts(unknown, {}, &report).size(), 2U);
+  EXPECT_EQ(report.welded_vertices, 0);
+  // The caller's tolerance replaces the default; 2.5 m welds vertex 6 to vertex 5 too.
+  const std::string metres = write("metres.ts", near_coincident_tsurf("m", 1.0));
+  EXPECT_EQ(meccano::read_surface_parts(metres, {.weld_tolerance = 0.0}, &report).size(), 2U);
+  EXPECT_EQ(report.welded_vertices + report.degenerate_triangles, 0);
+  const TriangleSurface wide = meccano::read_surface(metres, {.weld_tolerance = 2.5}, &report);
+  EXPECT_EQ(report.welded_vertices, 2);
+  EXPECT_EQ(report.degenerate_triangles, 2);
+  EXPECT_EQ(wide.triangles.size(), 2U);
+}
+
+TEST_F(SurfaceIo, WeldToleranceAppliesToEveryFormat) {
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1.001 0 0\nv 1 1 0\nf 1 2 3\nf 2 4 5\nf 2 5 3\nf 1 2 3\n";
+  // By default nothing is dropped: the repeated triangle is left for the validation to report.
+  meccano::SurfaceReadReport report;
+  EXPECT_EQ(meccano::read_surface(write("t.obj", obj), {}, &report).triangles.size(), 4U);
+  EXPECT_EQ(report.welded_vertices + report.degenerate_triangles + report.duplicate_triangles, 0);
+  const TriangleSurface welded = meccano::read_surface(write("t.obj", obj), {.weld_tolerance = 0.01}, &report);
+  EXPECT_EQ(welded.triangles.size(), 2U);
+  EXPECT_EQ(welded.points.size(), 4U);
+  EXPECT_EQ(report.welded_vertices, 1);
+  EXPECT_EQ(report.degenerate_triangles, 1);
+  EXPECT_EQ(report.duplicate_triangles, 1);
+  // STL shares vertices by repeating them exactly: those merges are not counted as welds.
+  meccano::read_surface(write("grid.stl", stl_ascii_text(grid_patch())), {}, &report);
+  EXPECT_EQ(report.welded_vertices, 0);
+}
+
+TEST_F(SurfaceIo, TsurfErrorsNameTheLineAndTheDefect) {
+  const std::string start = "GOCAD TSurf 1\nTFACE\nVRTX 1 0 0 0\nVRTX 2 1 0 0\n";  // lines 1-4
+  const std::pair<std::string, std::string> cases[] = {
+      {start + "VRTX 3 0 1 0\nTRGL 1 2 9\nEND\n",
+       "bad.ts:6: TRGL refers to unknown vertex id 9 (no VRTX, PVRTX, ATOM or PATOM of the object defines it before)"},
+      {start + "PVRTX 2 0 1 0 5\n", "bad.ts:5: vertex id 2 is defined twice in the object (first at line 4)"},
+      {start + "ATOM 3 1\nATOM 1 2\n", "bad.ts:6: vertex id 1 is defined twice in the object (first at line 3)"},
+      {start + "ATOM 3 7\n", "bad.ts:5: ATOM refers to unknown vertex id 7"},
+      {start + "PATOM 3 x 1.0\n", "bad.ts:5: malformed vertex id 'x'"},
+      {start + "VRTX 3 0 1.0.0 0\n", "bad.ts:5: malformed coordinate '1.0.0'"},
+      {start + "VRTX 3 0 nan 0\n", "bad.ts:5: non-finite coordinate 'nan'"},
+      {start + "VRTX 3 0 1e999 0\n", "bad.ts:5: non-finite coordinate '1e999'"},
+      {start + "VRTX 3 0 1\nTRGL 1 2 3\n", "bad.ts:5: expected vertex coordinate before the end of the line"},
+      {start + "TRGL 1 2\n", "bad.ts:5: expected vertex id before the end of the line"},
+      {"GOCAD TSurf 1\nVRTX 1 0 0 0\n", "bad.ts:2: 'VRTX' outside a TFACE block (no TFACE since the object's start at "
+                                        "line 1)"},
+      {start + "END\nGOCAD TSurf 1\nTRGL 1 2 3\n", "bad.ts:7: 'TRGL' outside a TFACE block"},
+      {start + "END\n", "bad.ts: no triangles in the file"},
+      {start + "VRTX 3 0 0 1e-9\nTRGL 1 2 3\nEND\n", "bad.ts: no triangles left after welding: all 1 collapsed"},
+      {"# exported\nsolid fault\n",
+       "bad.ts:2: not a GOCAD TSurf file: it starts with 'solid' instead of 'GOCAD TSurf'"},
+      {"# only a comment\n", "bad.ts:1: unexpected end of file (expected 'GOCAD TSurf' header)"},
+      {"GOCAD PLine 1\nHEADER {name:trace}\nEND\n", "bad.ts:1: not a TSurf: a GOCAD 'PLine' object"},
+      {start + "VRTX 3 0 1 0\nTRGL 1 2 3\nEND\nGOCAD Well 1\n", "bad.ts:8: not a TSurf: a GOCAD 'Well' object"},
+      {start + "VRTX 3 0 1 0\nTRGL 1 2 3\nEND\nTFACE\n", "bad.ts:8: expected 'GOCAD TSurf' (another object) or the end "
+                                                        "of the file after END, found 'TFACE'"},
+      {start + "VRTX 3 0 1 0\nTRGL 1 2 3\n", "bad.ts:6: unexpected end of file (expected 'END' of the object that "
+                                             "starts at line 1)"},
+      {start + "GOCAD TSurf 1\n",
+       "bad.ts:5: 'GOCAD' starts an object before the END of the object that starts at line 1"},
+      {"GOCAD TSurf 1\nHEADER {\nname:x\n", "bad.ts:2: the 'HEADER' block has no closing '}'"},
+  };
+  for (const auto& [text, expected] : cases) EXPECT_THAT(read_error("bad.ts", text), HasSubstr(expected)) << text;
 }
 
 }  // namespace

@@ -44,7 +44,18 @@ Options:
   --cells NX,NY,NZ         cell counts (default: equal cells as close to cubes as possible)
   --level K                uniform bisection levels: 6·2^K tets per cell (default 0)
   --surface FILE[:NAME]    an open triangulated surface strictly inside the box (.obj, .stl, .off,
-                           .msh); NAME defaults to its 1-based position (may repeat)
+                           .msh, .ts GOCAD TSurf); NAME defaults to its 1-based position (may repeat).
+                           Coordinates are taken as in the file: a TSurf's z is its own (a ZPOSITIVE
+                           Depth file keeps its positive depths), so give the box in the same terms
+  --weld-tolerance D       weld the vertices of each surface file closer than D (absolute, in the
+                           file's units) and drop the triangles this collapses or makes repeat another;
+                           the surface's progress line counts both (default: 1 m in a .ts file's
+                           AXIS_UNIT, or 1e-6 of its bounding-box diagonal when the unit is missing or
+                           unknown; 1e-10 of the diagonal for the other formats, which then drop
+                           nothing)
+  --split-parts            insert each part of a surface file (its triangles joined through shared
+                           edges) as its own surface NAME_1, NAME_2, ... in file order; without it a
+                           .ts file of several parts is an error that names them
   --resolution L           l_r: tets meeting a surface are refined until their longest edge is below L
                            (required with --surface)
   --stage STAGE            stop after this stage and write its result (default: smoothing, the whole
@@ -121,6 +132,10 @@ Examples:
   meccano-immerse --box 0,0,0,1,1,1 --level 6 --msh-version 2.2 --output cube22.msh --output cube.mesh
   meccano-immerse --box 0,0,0,1,1,1 --surface patch.obj:fault --resolution 0.03 \
                   --stage volumetric --output fault_vm.msh
+  meccano-immerse --box 605286,3617565,-7777,610241,3624984,773 --surface shell_beds.ts:fault \
+                  --resolution 350 --output fault.msh               (a GOCAD TSurf fault in UTM metres)
+  meccano-immerse --box 0,0,0,1,1,1 --surface faults.ts:f --split-parts --resolution 0.03 \
+                  --output faults.msh                               (surfaces f_1, f_2, ... per part)
   meccano-immerse check fault.msh --report fault_check.json
   meccano-immerse measure fault.msh --surface patch.obj:fault --report fault_measure.json
 )";
@@ -161,6 +176,8 @@ struct Options {
   int level = 0;
   std::vector<Output> outputs;
   std::vector<std::pair<std::string, std::string>> surfaces;  // file, name
+  meccano::SurfaceReadOptions reading;
+  bool split_parts = false;
   std::optional<double> resolution;
   std::optional<std::string> stage;
   meccano::SideRule side_rule = meccano::SideRule::positive_first;
@@ -232,6 +249,12 @@ Options parse_options(int argc, char** argv) {
       if (options.level < 0 || options.level > 40) throw UsageError("--level must be between 0 and 40");
     } else if (arg == "--surface") {
       options.surfaces.push_back(parse_surface(value(), options.surfaces.size() + 1));
+    } else if (arg == "--weld-tolerance") {
+      const double tolerance = parse_numbers(arg, value(), 1)[0];
+      if (tolerance < 0) throw UsageError("--weld-tolerance must not be negative");
+      options.reading.weld_tolerance = tolerance;
+    } else if (arg == "--split-parts") {
+      options.split_parts = true;
     } else if (arg == "--resolution") {
       const double l = parse_numbers(arg, value(), 1)[0];
       if (!(l > 0)) throw UsageError("--resolution must be positive");
@@ -307,6 +330,10 @@ Options parse_options(int argc, char** argv) {
     throw UsageError("--resolution, --stage and --histograms need at least one --surface");
   if (options.histograms && options.stage && *options.stage != "smoothing")
     throw UsageError("--histograms compares the mesh before and after smoothing: it needs --stage smoothing");
+  if (options.surfaces.empty() && (options.reading.weld_tolerance || options.split_parts))
+    throw UsageError("--weld-tolerance and --split-parts need at least one --surface");
+  // Distinct names stay distinct with --split-parts, which splits every surface: in a part's NAME_K,
+  // K is what follows the last '_'.
   for (std::size_t i = 0; i < options.surfaces.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (options.surfaces[i].second == options.surfaces[j].second)
@@ -315,6 +342,43 @@ Options parse_options(int argc, char** argv) {
 }
 
 using meccano::tools::Progress;
+
+// ", 3 vertices welded, 1 degenerate triangle dropped": what welding did to a surface file, if anything.
+std::string welding_summary(const meccano::SurfaceReadReport& report) {
+  std::string summary;
+  const auto add = [&summary](int count, const char* one, const char* many) {
+    if (count > 0) summary += ", " + std::to_string(count) + " " + (count == 1 ? one : many);
+  };
+  add(report.welded_vertices, "vertex welded", "vertices welded");
+  add(report.degenerate_triangles, "degenerate triangle dropped", "degenerate triangles dropped");
+  add(report.duplicate_triangles, "duplicate triangle dropped", "duplicate triangles dropped");
+  return summary;
+}
+
+// The surfaces of the --surface options, named; with --split-parts, one per part of each file.
+std::vector<meccano::TriangleSurface> read_surfaces(const Options& options, const Progress& progress) {
+  std::vector<meccano::TriangleSurface> surfaces;
+  for (const auto& [file, name] : options.surfaces) {
+    meccano::SurfaceReadReport report;
+    if (!options.split_parts) {
+      meccano::TriangleSurface& surface = surfaces.emplace_back(meccano::read_surface(file, options.reading, &report));
+      surface.name = name;
+      progress.say("surface ", name, ": ", file, ", ", surface.triangles.size(), " triangles, ", surface.points.size(),
+                   " points", welding_summary(report));
+      continue;
+    }
+    std::vector<meccano::TriangleSurface> parts = meccano::read_surface_parts(file, options.reading, &report);
+    progress.say("surface ", name, ": ", file, ", ", parts.size(), parts.size() == 1 ? " part" : " parts",
+                 welding_summary(report));
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      meccano::TriangleSurface& part = surfaces.emplace_back(std::move(parts[k]));
+      part.name = name + "_" + std::to_string(k + 1);
+      progress.say("surface ", part.name, ": part ", k + 1, " of ", file, ", ", part.triangles.size(), " triangles, ",
+                   part.points.size(), " points");
+    }
+  }
+  return surfaces;
+}
 
 int run(const Options& options) {
   const Progress progress(options.quiet);
@@ -325,13 +389,7 @@ int run(const Options& options) {
                expected_tets, " tets");
   meccano::check_tet_estimate(expected_tets, options.max_tets, "the meccano mesh (--cells, --level)");
   // Read and validate every surface before any meshing: bad input must not cost a meshing run.
-  std::vector<meccano::TriangleSurface> surfaces;
-  for (const auto& [file, name] : options.surfaces) {
-    surfaces.push_back(meccano::read_surface(file));
-    surfaces.back().name = name;
-    progress.say("surface ", name, ": ", file, ", ", surfaces.back().triangles.size(), " triangles, ",
-                 surfaces.back().points.size(), " points");
-  }
+  std::vector<meccano::TriangleSurface> surfaces = read_surfaces(options, progress);
   meccano::validate_surfaces(surfaces, options.box);
   if (!surfaces.empty()) progress.say("surfaces valid: open disks, inside the box, disjoint");
 

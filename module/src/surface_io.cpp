@@ -1,11 +1,14 @@
-// Surface readers (OBJ, STL, OFF, Gmsh MSH) and vertex welding.
+// Surface readers (OBJ, STL, OFF, Gmsh MSH, GOCAD TSurf), vertex welding and the parts of a surface.
 //
 // Every reader loads the whole file, parses it with FileCursor (text tokens with line numbers, or
 // binary values), and hands the raw points and triangles to finish_surface, which welds the
-// duplicated vertices and drops the unused ones. Header counts are checked against the bytes left in the file
-// before anything is allocated from them, so a corrupt count yields an error instead of a bad_alloc.
+// duplicated vertices, drops the triangles a deliberate weld collapsed, and drops the unused
+// vertices. Header counts are checked against the bytes left in the file before anything is
+// allocated from them, so a corrupt count yields an error instead of a bad_alloc.
 #include <meccano/error.hpp>
 #include <meccano/surface.hpp>
+
+#include "topology_helpers.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -19,6 +22,7 @@
 #include <fstream>
 #include <limits>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string_view>
 #include <unordered_map>
@@ -29,21 +33,18 @@ namespace {
 
 using Triangle = std::array<int, 3>;
 
-constexpr double kWeldRelativeTolerance = 1e-10;  // times the bounding-box diagonal
-
 [[noreturn]] void fail_file(const std::string& path, const std::string& defect) {
   throw InputError(path + ": " + defect);
 }
 
 // A token for an error message: file contents may be binary garbage or a megabyte without spaces.
-std::string quoted(std::string_view text) {
-  constexpr std::size_t kMaxShown = 40;
+std::string quoted(std::string_view text, std::size_t max_shown = 40) {
   std::string shown;
-  for (const char ch : text.substr(0, kMaxShown)) {
+  for (const char ch : text.substr(0, max_shown)) {
     const auto code = static_cast<unsigned char>(ch);
     shown += (code < 0x20 || code == 0x7f) ? '?' : ch;
   }
-  if (text.size() > kMaxShown) shown += "...";
+  if (text.size() > max_shown) shown += "...";
   return "'" + shown + "'";
 }
 
@@ -107,19 +108,27 @@ class FileCursor {
       fail_at(token.line, "expected '" + std::string(keyword) + "', found " + quoted(token.text));
     return token;
   }
-  void skip_line() {
+  void skip_line() { rest_of_line(); }
+  // The raw rest of the current line (comments included), moving to the start of the next one.
+  std::string_view rest_of_line() {
     const std::size_t end = bytes_.find('\n', pos_);
+    const std::string_view rest = bytes_.substr(pos_, end == std::string_view::npos ? end : end - pos_);
     pos_ = end == std::string_view::npos ? bytes_.size() : end + 1;
     if (end != std::string_view::npos) ++line_;
+    return rest;
   }
   // Moves just past the next occurrence of `marker`; false (and no move) when there is none.
-  bool skip_past(std::string_view marker) {
+  bool skip_past(std::string_view marker) { return text_until(marker).has_value(); }
+  // The raw text up to the next occurrence of `marker`, moving just past it; none (and no move) when
+  // there is none.
+  std::optional<std::string_view> text_until(std::string_view marker) {
     const std::size_t found = bytes_.find(marker, pos_);
-    if (found == std::string_view::npos) return false;
+    if (found == std::string_view::npos) return std::nullopt;
+    const std::string_view text = bytes_.substr(pos_, found - pos_);
     const std::size_t end = found + marker.size();
     line_ += static_cast<int>(std::ranges::count(bytes_.substr(pos_, end - pos_), '\n'));
     pos_ = end;
-    return true;
+    return text;
   }
 
   long long integer(const Token& token, std::string_view what) const {
@@ -239,26 +248,69 @@ double used_bounding_box_diagonal(const TriangleSurface& surface) {
   return (hi - lo).stableNorm();
 }
 
-// Removes the vertices no triangle uses, keeping the others in file order (messages number them).
-void drop_unused_vertices(TriangleSurface& surface) {
-  std::vector<Eigen::Vector3d>& points = surface.points;
-  std::vector<int> new_index(points.size(), -1);
-  for (const Triangle& triangle : surface.triangles)
-    for (const int vertex : triangle) new_index[static_cast<std::size_t>(vertex)] = 0;
-  std::size_t kept = 0;
-  for (std::size_t v = 0; v < points.size(); ++v)
-    if (new_index[v] == 0) {
-      new_index[v] = static_cast<int>(kept);
-      points[kept++] = points[v];
-    }
-  points.resize(kept);
-  for (Triangle& triangle : surface.triangles)
-    for (int& vertex : triangle) vertex = new_index[static_cast<std::size_t>(vertex)];
+// The points that `triangles` use, in their order in `points` (messages number them), the triangles
+// renumbered to them. Sorting, not marking, costs a part of a surface only its own size.
+std::vector<Eigen::Vector3d> used_vertices(const std::vector<Eigen::Vector3d>& points,
+                                           std::vector<Triangle>& triangles) {
+  std::vector<int> used;
+  used.reserve(3 * triangles.size());
+  for (const Triangle& triangle : triangles) used.insert(used.end(), triangle.begin(), triangle.end());
+  std::ranges::sort(used);
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  for (Triangle& triangle : triangles)
+    for (int& vertex : triangle) vertex = static_cast<int>(std::ranges::lower_bound(used, vertex) - used.begin());
+  std::vector<Eigen::Vector3d> kept;
+  kept.reserve(used.size());
+  for (const int vertex : used) kept.push_back(points[static_cast<std::size_t>(vertex)]);
+  return kept;
 }
 
-// The common end of every reader: the raw data has finite coordinates and in-range indices.
+// How a reader welds: within `tolerance` when it is set, else within `relative` times the bounding-box
+// diagonal. A deliberate weld (`drop_collapsed`) merges vertices that the file keeps apart, so the
+// triangles it collapses or makes repeat another are its doing and are dropped; the tiny default
+// weld leaves such triangles to the validation, which reports them as defects of the file.
+struct Weld {
+  std::optional<double> tolerance;
+  double relative = 0.0;
+  bool drop_collapsed = false;
+};
+
+constexpr Weld kTinyWeld{std::nullopt, 1e-10, false};
+
+// What a reader is asked for, and what it reports.
+struct ReadContext {
+  SurfaceReadOptions options;
+  SurfaceReadReport report;
+};
+
+// Drops the triangles with two equal corners and the repeats of an earlier triangle (the same three
+// vertices, in either orientation), counting both; `tags`, one per triangle, follow the kept ones.
+void drop_collapsed_triangles(TriangleSurface& surface, SurfaceReadReport& report, std::vector<int>* tags) {
+  std::set<Triangle> seen;
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+    const Triangle triangle = surface.triangles[t];
+    Triangle sorted = triangle;
+    std::ranges::sort(sorted);
+    if (sorted[0] == sorted[1] || sorted[1] == sorted[2]) {
+      ++report.degenerate_triangles;
+    } else if (!seen.insert(sorted).second) {
+      ++report.duplicate_triangles;
+    } else {
+      if (tags) (*tags)[kept] = (*tags)[t];
+      surface.triangles[kept++] = triangle;
+    }
+  }
+  surface.triangles.resize(kept);
+  if (tags) tags->resize(kept);
+}
+
+// The common end of every reader: the raw data has finite coordinates and in-range indices. The
+// user's weld tolerance, if any, replaces the format's `weld`; `tags`, one per triangle, follow the
+// triangles kept.
 TriangleSurface finish_surface(const std::string& path, std::vector<Eigen::Vector3d> points,
-                               std::vector<Triangle> triangles) {
+                               std::vector<Triangle> triangles, ReadContext& context,
+                               const Weld& format_weld = kTinyWeld, std::vector<int>* tags = nullptr) {
   if (triangles.empty()) fail_file(path, "no triangles in the file");
   TriangleSurface surface;
   surface.name = std::filesystem::path(path).stem().string();
@@ -268,9 +320,18 @@ TriangleSurface finish_surface(const std::string& path, std::vector<Eigen::Vecto
   const double diagonal = used_bounding_box_diagonal(surface);
   if (!std::isfinite(diagonal))
     fail_file(path, "coordinates too far apart: the extent of the surface overflows a double");
-  // Welding first leaves fewer vertices to scan (an STL file repeats each about six times).
-  weld_vertices(surface, kWeldRelativeTolerance * diagonal);
-  drop_unused_vertices(surface);
+  const Weld weld = context.options.weld_tolerance ? Weld{context.options.weld_tolerance, 0.0, true} : format_weld;
+  // Exact repeats first, uncounted: they are how an STL file shares its vertices (about six times
+  // each), and merging them leaves fewer vertices to scan.
+  weld_vertices(surface, 0.0);
+  context.report.welded_vertices = weld_vertices(surface, weld.tolerance.value_or(weld.relative * diagonal));
+  if (weld.drop_collapsed) {
+    drop_collapsed_triangles(surface, context.report, tags);
+    if (surface.triangles.empty())
+      fail_file(path, "no triangles left after welding: all " + std::to_string(context.report.degenerate_triangles) +
+                          " collapsed");
+  }
+  surface.points = used_vertices(surface.points, surface.triangles);
   return surface;
 }
 
@@ -287,7 +348,7 @@ std::string index_range(long long first, long long count) {
 
 // ---------------------------------------------------------------------------------------------- OBJ
 
-TriangleSurface parse_obj(const std::string& path, std::string_view bytes) {
+TriangleSurface parse_obj(const std::string& path, std::string_view bytes, ReadContext& context) {
   FileCursor cursor(path, bytes, '#');
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> triangles;
@@ -328,7 +389,7 @@ TriangleSurface parse_obj(const std::string& path, std::string_view bytes) {
       if (vertex >= vertex_count)
         cursor.fail_at(triangle_lines[t], "vertex index " + std::to_string(vertex + 1) + " out of range (" +
                                               index_range(1, vertex_count) + ")");
-  return finish_surface(path, std::move(points), std::move(triangles));
+  return finish_surface(path, std::move(points), std::move(triangles), context);
 }
 
 // ---------------------------------------------------------------------------------------------- STL
@@ -356,7 +417,7 @@ bool looks_like_text(std::string_view bytes) {
   });
 }
 
-TriangleSurface parse_binary_stl(const std::string& path, std::string_view bytes) {
+TriangleSurface parse_binary_stl(const std::string& path, std::string_view bytes, ReadContext& context) {
   const std::uint64_t count = binary_stl_count(bytes);
   const std::uint64_t expected = kStlHeaderBytes + kStlRecordBytes * count;
   if (expected != bytes.size())
@@ -384,10 +445,10 @@ TriangleSurface parse_binary_stl(const std::string& path, std::string_view bytes
     cursor.skip_bytes(2, "attribute");
     triangles.push_back({first, first + 1, first + 2});
   }
-  return finish_surface(path, std::move(points), std::move(triangles));
+  return finish_surface(path, std::move(points), std::move(triangles), context);
 }
 
-TriangleSurface parse_ascii_stl(const std::string& path, std::string_view bytes) {
+TriangleSurface parse_ascii_stl(const std::string& path, std::string_view bytes, ReadContext& context) {
   FileCursor cursor(path, bytes);
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> triangles;
@@ -426,7 +487,20 @@ TriangleSurface parse_ascii_stl(const std::string& path, std::string_view bytes)
     cursor.expect_keyword("endfacet");
     triangles.push_back({first, first + 1, first + 2});
   }
-  return finish_surface(path, std::move(points), std::move(triangles));
+  return finish_surface(path, std::move(points), std::move(triangles), context);
+}
+
+TriangleSurface parse_stl(const std::string& path, std::string_view bytes, ReadContext& context) {
+  const bool binary_size = bytes.size() >= kStlHeaderBytes &&
+                           bytes.size() == kStlHeaderBytes + kStlRecordBytes * binary_stl_count(bytes);
+  if (!binary_size && looks_like_text(bytes)) {
+    if (!starts_with_solid(bytes)) fail_file(path, "not an STL file: text that does not start with 'solid'");
+    return parse_ascii_stl(path, bytes, context);
+  }
+  if (bytes.size() < kStlHeaderBytes)
+    fail_file(path, "not an STL file: " + std::to_string(bytes.size()) +
+                        " bytes, too short for a binary STL (at least 84 bytes)");
+  return parse_binary_stl(path, bytes, context);
 }
 
 // ---------------------------------------------------------------------------------------------- OFF
@@ -438,7 +512,7 @@ bool is_off_keyword(std::string_view text) {
          text.substr(0, text.size() - 3).find_first_not_of("STCN") == std::string_view::npos;
 }
 
-TriangleSurface parse_off(const std::string& path, std::string_view bytes) {
+TriangleSurface parse_off(const std::string& path, std::string_view bytes, ReadContext& context) {
   FileCursor cursor(path, bytes, '#');
   const Token header = cursor.expect_token("'OFF' header");
   if (!is_off_keyword(header.text))
@@ -482,7 +556,7 @@ TriangleSurface parse_off(const std::string& path, std::string_view bytes) {
     add_polygon(polygon, triangles);
     cursor.skip_line();  // colour
   }
-  return finish_surface(path, std::move(points), std::move(triangles));
+  return finish_surface(path, std::move(points), std::move(triangles), context);
 }
 
 // ---------------------------------------------------------------------------------------------- MSH
@@ -505,7 +579,7 @@ class MshReader {
  public:
   MshReader(const std::string& path, std::string_view bytes) : cursor_(path, bytes) {}
 
-  TriangleSurface read() {
+  TriangleSurface read(ReadContext& context) {
     read_format();
     while (const std::optional<Token> section = cursor_.next_token()) {
       if (!section->text.starts_with('$'))
@@ -538,7 +612,7 @@ class MshReader {
       }
     }
     if (triangles.empty()) fail_file(cursor_.path(), "no triangles (element type 2) in the file");
-    return finish_surface(cursor_.path(), std::move(points_), std::move(triangles));
+    return finish_surface(cursor_.path(), std::move(points_), std::move(triangles), context);
   }
 
  private:
@@ -766,6 +840,349 @@ class MshReader {
   std::vector<PendingTriangle> pending_;
 };
 
+TriangleSurface parse_msh(const std::string& path, std::string_view bytes, ReadContext& context) {
+  return MshReader(path, bytes).read(context);
+}
+
+// -------------------------------------------------------------------------------------------- parts
+
+// The parts of a surface: its triangles joined through shared edges, numbered from 0 in the order of
+// their first triangles.
+struct Parts {
+  std::vector<int> of_triangle;
+  int count = 0;
+};
+
+Parts surface_parts(const std::vector<Triangle>& triangles) {
+  std::vector<std::pair<detail::Edge, std::size_t>> edges;  // (edge, triangle)
+  edges.reserve(3 * triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (std::size_t k = 0; k < 3; ++k)
+      edges.push_back({detail::make_edge(triangles[t][k], triangles[t][(k + 1) % 3]), t});
+  std::ranges::sort(edges);
+  detail::UnionFind sets(triangles.size());
+  for (std::size_t i = 1; i < edges.size(); ++i)
+    if (edges[i].first == edges[i - 1].first) sets.join(edges[i - 1].second, edges[i].second);
+  Parts parts;
+  std::vector<int> part_of_root(triangles.size(), -1);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    int& part = part_of_root[sets.find(t)];
+    if (part < 0) part = parts.count++;
+    parts.of_triangle.push_back(part);
+  }
+  return parts;
+}
+
+// One surface per part, named NAME_1, NAME_2, ...
+std::vector<TriangleSurface> split_into_parts(const TriangleSurface& surface) {
+  const Parts parts = surface_parts(surface.triangles);
+  std::vector<TriangleSurface> split(static_cast<std::size_t>(parts.count));
+  for (std::size_t p = 0; p < split.size(); ++p) {
+    split[p].name = surface.name + "_" + std::to_string(p + 1);
+    split[p].source = surface.source;
+  }
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t)
+    split[static_cast<std::size_t>(parts.of_triangle[t])].triangles.push_back(surface.triangles[t]);
+  for (TriangleSurface& part : split) part.points = used_vertices(surface.points, part.triangles);
+  return split;
+}
+
+// -------------------------------------------------------------------------------------------- TSurf
+
+constexpr double kTsurfWeldMetres = 1.0;              // coincident vertices of real files lie up to this apart
+constexpr double kTsurfRelativeWeldTolerance = 1e-6;  // times the bounding-box diagonal, when the unit is unknown
+
+// Metres in one AXIS_UNIT of a GOCAD coordinate system (quoted or not); 0 when the unit is unknown.
+double metres_per_unit(std::string_view unit) {
+  constexpr std::array<std::pair<std::string_view, double>, 13> kUnits{{
+      {"m", 1.0}, {"meter", 1.0}, {"meters", 1.0}, {"metre", 1.0}, {"metres", 1.0},
+      {"km", 1000.0}, {"kilometer", 1000.0}, {"kilometers", 1000.0}, {"kilometre", 1000.0}, {"kilometres", 1000.0},
+      {"ft", 0.3048}, {"foot", 0.3048}, {"feet", 0.3048}}};
+  if (unit.size() >= 2 && unit.front() == '"' && unit.back() == '"') unit = unit.substr(1, unit.size() - 2);
+  for (const auto& [name, metres] : kUnits)
+    if (iequals(unit, name)) return metres;
+  return 0.0;
+}
+
+std::string_view trimmed(std::string_view text) {
+  const std::size_t first = text.find_first_not_of(" \t\r");
+  if (first == std::string_view::npos) return {};
+  return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
+}
+
+// A TSurf file's surface (all its objects), with the TFACE each triangle comes from, for messages.
+struct TsurfFile {
+  struct Tface {
+    int line;    // of its TFACE keyword
+    int object;  // index in `objects`
+  };
+  TriangleSurface surface;
+  std::vector<int> tface_of_triangle;  // index in `tfaces`
+  std::vector<Tface> tfaces;
+  std::vector<std::string> objects;  // each object's HEADER name, empty when it has none
+};
+
+// GOCAD TSurf: one or more objects `GOCAD TSurf 1` ... `END`, each numbering its own vertices. Read:
+// the geometry (VRTX, PVRTX, ATOM, PATOM and TRGL, in TFACE blocks), the HEADER's name and the
+// AXIS_UNIT; other keyword lines (BSTONE, BORDER, PROPERTIES, ...) and blocks in braces are skipped.
+class TsurfReader {
+ public:
+  TsurfReader(const std::string& path, std::string_view bytes) : cursor_(path, bytes, '#') {}
+
+  TsurfFile read(ReadContext& context) {
+    start_object(cursor_.expect_token("'GOCAD TSurf' header"));
+    while (const std::optional<Token> keyword = cursor_.next_token()) {
+      if (object_line_ == 0)
+        start_object(*keyword);
+      else
+        read_keyword(*keyword);
+    }
+    if (object_line_ != 0)
+      cursor_.fail_at_end("'END' of the object that starts at line " + std::to_string(object_line_));
+    file_.surface = finish_surface(cursor_.path(), std::move(points_), std::move(triangles_), context, weld(),
+                                   &file_.tface_of_triangle);
+    return std::move(file_);
+  }
+
+ private:
+  struct Definition {  // of a vertex id
+    int point;
+    int line;
+  };
+
+  int object() const { return static_cast<int>(file_.objects.size()) - 1; }
+
+  void start_object(const Token& gocad) {
+    if (!iequals(gocad.text, "GOCAD")) {
+      if (file_.objects.empty())
+        cursor_.fail_at(gocad.line, "not a GOCAD TSurf file: it starts with " + quoted(gocad.text) +
+                                        " instead of 'GOCAD TSurf'");
+      cursor_.fail_at(gocad.line, "expected 'GOCAD TSurf' (another object) or the end of the file after END, found " +
+                                      quoted(gocad.text));
+    }
+    const Token type = cursor_.expect_token_on_line("GOCAD object type");
+    if (!iequals(type.text, "TSurf"))
+      cursor_.fail_at(type.line, "not a TSurf: a GOCAD " + quoted(type.text) +
+                                     " object (only TSurf objects, triangulated surfaces, can be read)");
+    cursor_.skip_line();  // the version
+    object_line_ = gocad.line;
+    file_.objects.emplace_back();
+    ids_.clear();
+    unit_ = 0.0;
+  }
+
+  void read_keyword(const Token& keyword) {
+    const std::string_view text = keyword.text;
+    if (text == "VRTX" || text == "PVRTX") {
+      add_vertex(keyword);
+    } else if (text == "ATOM" || text == "PATOM") {
+      add_atom(keyword);
+    } else if (text == "TRGL") {
+      add_triangle(keyword);
+    } else if (text == "TFACE") {
+      file_.tfaces.push_back({keyword.line, object()});
+      cursor_.skip_line();
+    } else if (text == "END") {
+      object_units_.push_back(unit_);
+      object_line_ = 0;
+      cursor_.skip_line();
+    } else if (text == "AXIS_UNIT") {
+      read_axis_unit();
+    } else if (iequals(text, "GOCAD")) {
+      cursor_.fail_at(keyword.line, "'GOCAD' starts an object before the END of the object that starts at line " +
+                                        std::to_string(object_line_));
+    } else {
+      skip_keyword(keyword);
+    }
+  }
+
+  // The geometry of an object lies in its TFACE blocks: a vertex before them has no part to go to.
+  void require_tface(const Token& keyword) const {
+    if (file_.tfaces.empty() || file_.tfaces.back().object != object())
+      cursor_.fail_at(keyword.line, quoted(keyword.text) + " outside a TFACE block (no TFACE since the object's " +
+                                        "start at line " + std::to_string(object_line_) + ")");
+  }
+
+  void add_vertex(const Token& keyword) {
+    require_tface(keyword);
+    define(cursor_.expect_token_on_line("vertex id"), static_cast<int>(points_.size()));
+    Eigen::Vector3d& p = points_.emplace_back();
+    for (int axis = 0; axis < 3; ++axis)
+      p[axis] = cursor_.coordinate(cursor_.expect_token_on_line("vertex coordinate"));
+    cursor_.skip_line();  // PVRTX's property values
+  }
+
+  // An atom is another id for an existing vertex.
+  void add_atom(const Token& keyword) {
+    require_tface(keyword);
+    const Token id = cursor_.expect_token_on_line("atom id");
+    define(id, point(keyword, cursor_.expect_token_on_line("vertex id")));
+    cursor_.skip_line();  // PATOM's property values
+  }
+
+  void add_triangle(const Token& keyword) {
+    require_tface(keyword);
+    Triangle& triangle = triangles_.emplace_back();
+    for (int& corner : triangle) corner = point(keyword, cursor_.expect_token_on_line("vertex id"));
+    file_.tface_of_triangle.push_back(static_cast<int>(file_.tfaces.size()) - 1);
+    cursor_.skip_line();
+  }
+
+  void define(const Token& id, int point) {
+    const long long value = cursor_.integer(id, "vertex id");
+    const auto [found, inserted] = ids_.try_emplace(value, Definition{point, id.line});
+    if (!inserted)
+      cursor_.fail_at(id.line, "vertex id " + std::to_string(value) +
+                                   " is defined twice in the object (first at line " +
+                                   std::to_string(found->second.line) + ")");
+  }
+
+  // The point a vertex id of the current object names.
+  int point(const Token& keyword, const Token& id) const {
+    const long long value = cursor_.integer(id, "vertex id");
+    const auto found = ids_.find(value);
+    if (found == ids_.end())
+      cursor_.fail_at(id.line, std::string(keyword.text) + " refers to unknown vertex id " + std::to_string(value) +
+                                   " (no VRTX, PVRTX, ATOM or PATOM of the object defines it before)");
+    return found->second.point;
+  }
+
+  // AXIS_UNIT "m" "m" "m": the unit common to the three axes; unknown (0) when they differ.
+  void read_axis_unit() {
+    std::optional<double> unit;
+    while (const std::optional<Token> token = cursor_.next_token_on_line()) {
+      const double metres = metres_per_unit(token->text);
+      unit = !unit || *unit == metres ? metres : 0.0;
+    }
+    unit_ = unit.value_or(0.0);
+    cursor_.skip_line();
+  }
+
+  // Skips a keyword line and the block in braces it opens, if any, keeping the HEADER's name.
+  void skip_keyword(const Token& keyword) {
+    const std::string_view rest = cursor_.rest_of_line();
+    const std::size_t open = rest.find('{');
+    if (open == std::string_view::npos) return;
+    std::string block(rest.substr(open + 1));
+    if (const std::size_t close = block.find('}'); close != std::string::npos) {
+      block.resize(close);
+    } else {
+      const std::optional<std::string_view> more = cursor_.text_until("}");
+      if (!more) cursor_.fail_at(keyword.line, "the " + quoted(keyword.text) + " block has no closing '}'");
+      block += '\n';
+      block += *more;
+      cursor_.skip_line();  // what follows the '}'
+    }
+    if (keyword.text == "HEADER") read_header(block);
+  }
+
+  // HEADER { key:value lines }: the name.
+  void read_header(std::string_view block) {
+    while (!block.empty()) {
+      const std::size_t end = block.find('\n');
+      const std::string_view line = trimmed(block.substr(0, end));
+      block = end == std::string_view::npos ? std::string_view() : block.substr(end + 1);
+      if (line.starts_with("name:")) file_.objects.back() = std::string(trimmed(line.substr(5)));
+    }
+  }
+
+  // One metre in the file's unit when every object gives the same known one; a deliberate weld.
+  Weld weld() const {
+    const bool known = !object_units_.empty() && std::ranges::all_of(object_units_, [&](double unit) {
+      return unit > 0.0 && unit == object_units_[0];
+    });
+    return {known ? std::optional(kTsurfWeldMetres / object_units_[0]) : std::nullopt, kTsurfRelativeWeldTolerance,
+            true};
+  }
+
+  FileCursor cursor_;
+  TsurfFile file_;
+  std::vector<Eigen::Vector3d> points_;
+  std::vector<Triangle> triangles_;
+  std::unordered_map<long long, Definition> ids_;  // of the current object
+  int object_line_ = 0;                            // of the current object's GOCAD line; 0 after its END
+  double unit_ = 0.0;                              // metres per AXIS_UNIT of the current object, 0 if unknown
+  std::vector<double> object_units_;
+};
+
+// Names a TFACE for messages: "TFACE 2 (line 40) of object 'fault A'".
+std::string tface_label(const TsurfFile& file, int tface) {
+  const TsurfFile::Tface& block = file.tfaces[static_cast<std::size_t>(tface)];
+  const std::string& name = file.objects[static_cast<std::size_t>(block.object)];
+  return "TFACE " + std::to_string(tface + 1) + " (line " + std::to_string(block.line) + ") of object " +
+         (name.empty() ? std::to_string(block.object + 1) : quoted(name, 100));
+}
+
+[[noreturn]] void fail_several_parts(const TsurfFile& file, const Parts& parts) {
+  constexpr int kMaxNamed = 20;
+  const auto named = static_cast<std::size_t>(std::min(parts.count, kMaxNamed));
+  std::vector<std::set<int>> tfaces(named);
+  std::vector<int> triangles(named, 0);
+  for (std::size_t t = 0; t < parts.of_triangle.size(); ++t)
+    if (const auto part = static_cast<std::size_t>(parts.of_triangle[t]); part < named) {
+      tfaces[part].insert(file.tface_of_triangle[t]);
+      ++triangles[part];
+    }
+  std::string message =
+      std::to_string(parts.count) + " parts (triangles joined through shared edges) where one surface is expected:";
+  for (std::size_t p = 0; p < named; ++p) {
+    message += " part " + std::to_string(p + 1) + ", " + std::to_string(triangles[p]) +
+               (triangles[p] == 1 ? " triangle in " : " triangles in ");
+    for (const int tface : tfaces[p])
+      message += (tface == *tfaces[p].begin() ? "" : " and ") + tface_label(file, tface);
+    message += ";";
+  }
+  if (parts.count > kMaxNamed) message += " and " + std::to_string(parts.count - kMaxNamed) + " more parts;";
+  fail_file(file.surface.source,
+            message + " --split-parts (read_surface_parts in the library) reads each part as its own surface");
+}
+
+// A TSurf file as one surface: refused, naming its parts, when it has several.
+TriangleSurface parse_tsurf(const std::string& path, std::string_view bytes, ReadContext& context) {
+  TsurfFile file = TsurfReader(path, bytes).read(context);
+  const Parts parts = surface_parts(file.surface.triangles);
+  if (parts.count > 1) fail_several_parts(file, parts);
+  return std::move(file.surface);
+}
+
+// A TSurf file whatever its parts.
+TriangleSurface parse_whole_tsurf(const std::string& path, std::string_view bytes, ReadContext& context) {
+  return TsurfReader(path, bytes).read(context).surface;
+}
+
+// ------------------------------------------------------------------------------------------ formats
+
+using Parser = TriangleSurface (*)(const std::string& path, std::string_view bytes, ReadContext& context);
+
+constexpr std::array<std::pair<std::string_view, Parser>, 5> kFormats{
+    {{".obj", parse_obj}, {".stl", parse_stl}, {".off", parse_off}, {".msh", parse_msh}, {".ts", parse_tsurf}}};
+
+std::string lowercase_extension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::ranges::transform(extension, extension.begin(),
+                         [](char ch) { return static_cast<char>(std::tolower(static_cast<unsigned char>(ch))); });
+  return extension;
+}
+
+Parser parser_for(const std::string& path) {
+  const std::string extension = lowercase_extension(path);
+  std::string supported;
+  for (const auto& [known, parser] : kFormats) {
+    if (extension == known) return parser;
+    supported += (supported.empty() ? "" : ", ") + std::string(known);
+  }
+  fail_file(path, (extension.empty() ? "no file extension" : "unsupported surface format '" + extension + "'") +
+                      " (supported: " + supported + ")");
+}
+
+TriangleSurface read_with(Parser parser, const std::string& path, const SurfaceReadOptions& options = {},
+                          SurfaceReadReport* report = nullptr) {
+  ReadContext context{options, {}};
+  TriangleSurface surface = parser(path, read_file_bytes(path), context);
+  if (report) *report = context.report;
+  return surface;
+}
+
 // ------------------------------------------------------------------------------------------ welding
 
 struct Cell {
@@ -887,39 +1304,21 @@ int weld_vertices(TriangleSurface& surface, double tolerance) {
   return merged;
 }
 
-TriangleSurface read_obj(const std::string& path) { return parse_obj(path, read_file_bytes(path)); }
+TriangleSurface read_obj(const std::string& path) { return read_with(parse_obj, path); }
+TriangleSurface read_stl(const std::string& path) { return read_with(parse_stl, path); }
+TriangleSurface read_off(const std::string& path) { return read_with(parse_off, path); }
+TriangleSurface read_msh_triangles(const std::string& path) { return read_with(parse_msh, path); }
+TriangleSurface read_tsurf(const std::string& path) { return read_with(parse_tsurf, path); }
 
-TriangleSurface read_stl(const std::string& path) {
-  const std::string bytes = read_file_bytes(path);
-  const bool binary_size = bytes.size() >= kStlHeaderBytes &&
-                           bytes.size() == kStlHeaderBytes + kStlRecordBytes * binary_stl_count(bytes);
-  if (!binary_size && looks_like_text(bytes)) {
-    if (!starts_with_solid(bytes)) fail_file(path, "not an STL file: text that does not start with 'solid'");
-    return parse_ascii_stl(path, bytes);
-  }
-  if (bytes.size() < kStlHeaderBytes)
-    fail_file(path, "not an STL file: " + std::to_string(bytes.size()) +
-                        " bytes, too short for a binary STL (at least 84 bytes)");
-  return parse_binary_stl(path, bytes);
+TriangleSurface read_surface(const std::string& path, const SurfaceReadOptions& options, SurfaceReadReport* report) {
+  return read_with(parser_for(path), path, options, report);
 }
 
-TriangleSurface read_off(const std::string& path) { return parse_off(path, read_file_bytes(path)); }
-
-TriangleSurface read_msh_triangles(const std::string& path) {
-  const std::string bytes = read_file_bytes(path);
-  return MshReader(path, bytes).read();
-}
-
-TriangleSurface read_surface(const std::string& path) {
-  std::string extension = std::filesystem::path(path).extension().string();
-  std::ranges::transform(extension, extension.begin(),
-                         [](char ch) { return static_cast<char>(std::tolower(static_cast<unsigned char>(ch))); });
-  if (extension == ".obj") return read_obj(path);
-  if (extension == ".stl") return read_stl(path);
-  if (extension == ".off") return read_off(path);
-  if (extension == ".msh") return read_msh_triangles(path);
-  fail_file(path, (extension.empty() ? "no file extension" : "unsupported surface format '" + extension + "'") +
-                      std::string(" (supported: .obj, .stl, .off, .msh)"));
+std::vector<TriangleSurface> read_surface_parts(const std::string& path, const SurfaceReadOptions& options,
+                                                SurfaceReadReport* report) {
+  // The TSurf parser refuses a file of several parts: read it whole.
+  const Parser parser = lowercase_extension(path) == ".ts" ? parse_whole_tsurf : parser_for(path);
+  return split_into_parts(read_with(parser, path, options, report));
 }
 
 }  // namespace meccano

@@ -49,15 +49,19 @@ class ScratchFile {
   std::string path_;
 };
 
+// The readers promise in-range indices in every surface they return.
+inline void check_indices(const TriangleSurface& surface) {
+  for (const auto& triangle : surface.triangles)
+    for (const int vertex : triangle)
+      if (vertex < 0 || static_cast<std::size_t>(vertex) >= surface.points.size()) std::abort();
+}
+
 template <class Reader>
 int read_surface_bytes(const std::uint8_t* data, std::size_t size, const std::string& extension, Reader read) {
   static const ScratchFile file(extension);
   const std::string& path = file.write(data, size);
   try {
-    const TriangleSurface surface = read(path);
-    for (const auto& triangle : surface.triangles)
-      for (const int vertex : triangle)
-        if (vertex < 0 || static_cast<std::size_t>(vertex) >= surface.points.size()) std::abort();
+    check_indices(read(path));
   } catch (const InputError&) {
   }
   return 0;

@@ -19,7 +19,7 @@ if [ "${1:-}" = --parallel ]; then parallel=1; shift; fi
 seconds=${1:-60}
 build=${2:-build-fuzz}
 jobs=$(( $(nproc) < 2 ? $(nproc) : 2 ))
-targets=(fuzz_read_obj fuzz_read_stl fuzz_read_off fuzz_read_msh fuzz_validate_surface)
+targets=(fuzz_read_obj fuzz_read_stl fuzz_read_off fuzz_read_msh fuzz_read_tsurf fuzz_validate_surface)
 
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DMECCANO_FUZZ=ON \
       -DMECCANO_BUILD_TESTS=OFF -DMECCANO_BUILD_SOLVER_DEMO=OFF > "$build.log" 2>&1 || { cat "$build.log"; exit 1; }

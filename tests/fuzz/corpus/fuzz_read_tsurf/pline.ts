@@ -1,0 +1,7 @@
+GOCAD PLine 1
+HEADER {name:trace}
+ILINE
+VRTX 1 0 0 0
+VRTX 2 1 0 0
+SEG 1 2
+END

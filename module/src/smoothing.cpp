@@ -330,7 +330,9 @@ double Smoother::choose_delta(VertexId v, double& length) const {
   });
   length = edges / std::max(count, 1);
   const double scale = sigma_sum / static_cast<double>(std::max<std::size_t>(star.size(), 1));
-  const double epsilon = untangling_epsilon_ * scale;
+  // The raised ε is for tangled stars only: on a valid star it would soften the barrier that keeps it
+  // valid, and untangling elsewhere would tangle it.
+  const double epsilon = (sigma_min <= 0.0 ? untangling_epsilon_ : initial_untangling_epsilon) * scale;
   const double untangling = sigma_min < epsilon ? std::sqrt(epsilon * (epsilon - sigma_min)) : 0.0;
   return std::max(untangling, 1e-4 * scale);
 }

@@ -8,7 +8,8 @@
 //          computational (meccano) counterpart, so an untouched tet is already optimal. h keeps η* finite
 //          and smooth through σ = 0, so inverted tets are pushed out of inversion by the same descent that
 //          improves valid ones. δ = max(√(ε(ε − σ_min)), 1e-4 · mean|σ|) over the node's star (Escobar et
-//          al.'s rule with the authors' floor), ε = 1e-3 · mean|σ| (see smoothing.cpp for why not theirs).
+//          al.'s rule with the authors' floor), ε = 1e-3 · mean|σ| (see smoothing.cpp for why not theirs),
+//          raised ten-fold on tangled stars while untangling stalls.
 //          While tets are inverted the objective is the paper's sum; once a sweep ends with none, it
 //          becomes Σ η*^p with p = `power` (the p-norm of Escobar et al. 2003, of which the paper's sum is
 //          p = 1), which weighs the worst tets more: on the cube example p = 4 raises the minimum quality
@@ -31,9 +32,9 @@
 //          the objective by less than `tolerance` (relative), or after `max_sweeps` sweeps.
 // Fallback If tets are still inverted after `fallback_sweeps` sweeps towards the meccano target, the
 //          untangling goes on towards the equilateral target, and the smoothing sweeps that follow the
-//          untangling aim at the meccano target again. Some projected S_M (a small disk, a few l_r across,
-//          whose rim moves by about l_r) leave stars whose meccano shapes cannot all be met: untangling
-//          stalls there, for any number of sweeps, while the equilateral target untangles it in about ten
+//          untangling aim at the meccano target again. Some projected S_M leave stars whose meccano shapes
+//          cannot all be met (one inverted tet between two rim nodes on a small disk): untangling stalls
+//          there for any number of sweeps, while the equilateral target untangles it at once
 //          (doc/results.md, Step 4). Should the meccano smoothing tangle the mesh again, the equilateral
 //          target is kept to the end.
 // Modes    whole mesh (the paper), or a band: only nodes within `band_rings` edge rings of an S_M node.

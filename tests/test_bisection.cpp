@@ -150,6 +150,49 @@ TEST(Bisection, RandomLocalRefinementStaysConformingWithThreeClasses) {
     }
 }
 
+TEST(Bisection, LevelCountsTheBisectionsFromTheMacroTet) {
+  for (std::size_t b = 0; b < test_boxes.size(); ++b) {
+    SCOPED_TRACE("box " + std::to_string(b));
+    TetMesh mesh = make_cube_meccano(test_boxes[b], 0);
+    std::vector<int> bisections(mesh.tets.size(), 0);  // child 0 keeps its parent's index
+    std::mt19937 rng(static_cast<unsigned>(b + 5));
+    for (int round = 0; round < 40; ++round) {
+      std::vector<TetId> marked;
+      for (int k = 0; k < 10; ++k) marked.push_back(std::uniform_int_distribution<TetId>(0, mesh.num_tets() - 1)(rng));
+      refine_marked(mesh, marked, [&](TetId parent, TetId) { bisections.push_back(++bisections[parent]); });
+    }
+    ASSERT_EQ(bisections.size(), mesh.tets.size());
+    EXPECT_GT(*std::max_element(bisections.begin(), bisections.end()), 6);
+    for (TetId t = 0; t < mesh.num_tets(); ++t) ASSERT_EQ(mesh.level(t), bisections[t]) << "tet " << t;
+  }
+}
+
+TEST(CubeMeccano, LongestEdgeAtALevelIsTheLongestEdgeOfItsTets) {
+  for (std::size_t b = 0; b < test_boxes.size(); ++b) {
+    SCOPED_TRACE("box " + std::to_string(b));
+    TetMesh mesh = make_cube_meccano(test_boxes[b], 0);
+    for (int level = 0; level <= 7; ++level) {
+      double longest = 0.0;
+      for (TetId t = 0; t < mesh.num_tets(); ++t) longest = std::max(longest, mesh.longest_edge(t));
+      EXPECT_NEAR(longest_edge_at_level(mesh.meccano, level), longest, 1e-12 * longest) << "level " << level;
+      refine_uniformly(mesh, 1);
+    }
+  }
+}
+
+TEST(CubeMeccano, LevelForResolutionIsTheCoarsestLevelShorterThanIt) {
+  const TetMesh mesh = make_cube_meccano(test_boxes[2], 0);  // cells of unequal sides
+  for (double resolution : {2.0, 0.9, 0.5, 0.31, 0.3, 0.1, 0.0417, 0.03125, 1e-3}) {
+    const int level = level_for_resolution(mesh.meccano, resolution);
+    EXPECT_LT(longest_edge_at_level(mesh.meccano, level), resolution) << resolution;
+    if (level > 0) {
+      EXPECT_GE(longest_edge_at_level(mesh.meccano, level - 1), resolution) << resolution;
+    }
+  }
+  EXPECT_THROW(level_for_resolution(mesh.meccano, 0.0), InputError);
+  EXPECT_THROW(level_for_resolution(mesh.meccano, 1e-12), InputError);  // beyond the computational grid
+}
+
 TEST(Bisection, TrackedOrientationMatchesGeometryAndBothSignsOccur) {
   TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 4);
   int negative = 0;

@@ -258,13 +258,13 @@ TEST(Smoothing, BandModeMovesOnlyNodesNearTheSurface) {
   EXPECT_GT(moved_in_band, 0);
 }
 
-// On this disk (found by stress_surfaces) untangling towards the meccano target stalls at a few inverted
-// tets on either side of S for any number of sweeps; the equilateral target untangles them, and the
-// smoothing then aims at the meccano target again.
+// On this disk (surface s1 of stress case 87, seed 1) untangling towards the meccano target stalls at one
+// inverted tet between two rim nodes for any number of sweeps; the equilateral target untangles it, and
+// the smoothing then aims at the meccano target again.
 TEST(Smoothing, FallsBackToTheEquilateralTargetWhereTheMeccanoTargetStalls) {
-  const TriangleSurface surface = read_surface(std::string(MECCANO_TEST_DATA_DIR) + "/small_disk_meccano_target_stalls.obj");
+  const TriangleSurface surface = read_surface(std::string(MECCANO_TEST_DATA_DIR) + "/disk_meccano_target_stalls.obj");
   InsertionOptions options;
-  options.resolution = 0.041507854398402787;
+  options.resolution = 0.025860230418841217;
   options.approximation.side_rule = SideRule::positive_only;
   const InsertionResult result = insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {&surface, 1}, options);
   EXPECT_TRUE(result.smoothing.untangled());
@@ -273,7 +273,7 @@ TEST(Smoothing, FallsBackToTheEquilateralTargetWhereTheMeccanoTargetStalls) {
   EXPECT_EQ(result.smoothing.sweeps.back().target, SmoothingTarget::meccano);
   EXPECT_TRUE(verify_mesh(result.mesh, {.physical = true}).ok());
   EXPECT_EQ(folded_triangles(result.surfaces[0].projection), 0);
-  EXPECT_GE(result.quality_after_smoothing.meccano.min, 0.29);
+  EXPECT_GE(result.quality_after_smoothing.meccano.min, 0.25);
 
   options.smoothing.fallback_sweeps = 0;
   options.smoothing.max_sweeps = 40;

@@ -54,14 +54,15 @@ TEST_P(SurfaceApproximationOn, IsAHealedDiskCloseToSAndOrientedLikeIt) {
     EXPECT_EQ(check.reflex_rim_corners, healing[s].reflex_corners_left);
     EXPECT_TRUE(check_ball(mesh, regions[s]).is_ball()) << "healing broke V_M";
 
-    // Nodes within l_r of S (growth_band * l_r where V_M's growth crossed the offset at l_r), and the
-    // faces' normals agree with S's nearby (area-weighted cosine).
+    // Nodes within V_M's reach of S (growth_band times it where V_M's growth crossed the offset at the
+    // reach), and the faces' normals agree with S's nearby (area-weighted cosine).
+    const double reach = growth_reach(mesh.meccano, c.resolution);
     const InterfaceFaces faces = interface_faces(mesh, regions[s], s, healing[s].side);
     ASSERT_EQ(static_cast<std::int64_t>(faces.triangles.size()), check.faces);
     double agreement = 0, area = 0;
     for (const auto& t : faces.triangles) {
       for (VertexId v : t)
-        ASSERT_LT(std::sqrt(trees[s].closest_point(mesh.points[v]).squared_distance), growth_band * c.resolution)
+        ASSERT_LT(std::sqrt(trees[s].closest_point(mesh.points[v]).squared_distance), growth_band * reach)
             << "S_M node " << v << " is far from S";
       const Eigen::Vector3d area_vector =
           0.5 * (mesh.points[t[1]] - mesh.points[t[0]]).cross(mesh.points[t[2]] - mesh.points[t[0]]);

@@ -98,4 +98,30 @@ TetMesh make_cube_meccano(const Box& box, const std::array<int, 3>& cells, int l
 
 TetMesh make_cube_meccano(const Box& box, int level) { return make_cube_meccano(box, cells_for_box(box), level); }
 
+double longest_edge_at_level(const MeccanoGrid& meccano, int level) {
+  const Box cell{Eigen::Vector3d::Zero(), meccano.cell_size};
+  const TetMesh refined = make_cube_meccano(cell, {1, 1, 1}, level % 3);
+  double longest = 0.0;
+  for (TetId t = 0; t < refined.num_tets(); ++t) longest = std::max(longest, refined.longest_edge(t));
+  return std::ldexp(longest, -(level / 3));
+}
+
+int level_for_resolution(const MeccanoGrid& meccano, double resolution) {
+  if (!(resolution > 0.0)) throw InputError("the resolution l_r must be positive (got " + std::to_string(resolution) + ")");
+  // Each three levels halve the edges; start near the answer and step to it.
+  const double diagonal = meccano.cell_size.norm();
+  int level = std::max(0, 3 * static_cast<int>(std::floor(std::log2(diagonal / resolution))) - 3);
+  while (level > 0 && longest_edge_at_level(meccano, level - 1) < resolution) --level;
+  while (longest_edge_at_level(meccano, level) >= resolution) {
+    // Computational coordinates have grid_bits bits per cell edge, three levels per bit.
+    if (++level > 3 * grid_bits - 12) {
+      std::ostringstream message;
+      message << "the resolution l_r = " << resolution << " is too fine for the meccano's cells (edge "
+              << meccano.cell_size.maxCoeff() << "): at most " << grid_bits - 4 << " halvings of a cell edge";
+      throw InputError(message.str());
+    }
+  }
+  return level;
+}
+
 }  // namespace meccano

@@ -26,6 +26,10 @@ void write_surface(JsonWriter& json, const SurfaceInsertion& inserted, Stage las
   const VolumetricStats& v = inserted.volumetric_stats;
   json.key("volumetric").begin_object();
   json.key("tets").value(v.tets).key("tets_meeting_surface").value(v.tets_intersecting);
+  json.key("level").value(v.level).key("reach").value(v.reach);
+  json.key("axis_tets").value(v.axis_tets).key("euler_node_stars").value(v.euler_node_stars);
+  json.key("cavity_tets").value(v.cavity_tets).key("thickening_layers").value(v.thickening_layers);
+  json.key("growth_refinements").value(v.growth_refinements);
   json.key("refinement_passes").value(v.refinement_passes).key("bisections").value(v.bisections);
   json.key("growth_passes").value(v.growth_passes).key("band_tets").value(v.band_tets);
   json.key("seconds").value(inserted.volumetric_seconds).end_object();
@@ -80,6 +84,7 @@ std::string insertion_report_json(const InsertionResult& result, Stage last_stag
   JsonWriter json;
   json.begin_object();
   json.key("tets").value(result.mesh.num_tets()).key("nodes").value(result.mesh.num_vertices());
+  json.key("estimated_tets").value(result.estimated_tets);
   const QualitySummary& final_quality = smoothed ? result.quality_after_smoothing : result.quality_before_smoothing;
   if (projected) {
     json.key("inverted").value(final_quality.inverted);

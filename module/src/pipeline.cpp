@@ -304,12 +304,14 @@ std::vector<int> surfaces_to_refine(std::span<const TriangleSurface> surfaces, s
 // The insertion at l_r, and where it fails, again with the failing surfaces at half their l_r.
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();
+  std::int64_t estimated_tets = mesh.num_tets();
   if (!surfaces.empty()) {
     if (!(options.resolution > 0.0))
       throw InputError("the resolution l_r must be positive (got " + std::to_string(options.resolution) + ")");
     std::ostringstream what;
     what << "the resolution l_r = " << options.resolution;
-    check_tet_estimate(estimate_tets(mesh.num_tets(), surfaces, options.resolution), options.max_tets, what.str());
+    estimated_tets = estimate_tets(mesh.num_tets(), surfaces, options.resolution);
+    check_tet_estimate(estimated_tets, options.max_tets, what.str());
   }
   const ThreadCount threads(options.threads);
   std::vector<double> resolutions(surfaces.size(), options.resolution);
@@ -319,6 +321,7 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
     try {
       InsertionResult result = insert_on_either_side(mesh, surfaces, options, resolutions);
       result.finer_retries = std::move(failures);
+      result.estimated_tets = estimated_tets;
       result.seconds = seconds_since(pipeline_start);
       return result;
     } catch (const SurfaceFailure& failure) {

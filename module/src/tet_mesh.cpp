@@ -3,6 +3,7 @@
 #include <meccano/error.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <cmath>
 #include <string>
@@ -62,6 +63,18 @@ double TetMesh::longest_edge(TetId t) const {
   for (int i = 0; i < 4; ++i)
     for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (p[i] - p[j]).squaredNorm());
   return std::sqrt(longest);
+}
+
+int TetMesh::level(TetId t) const {
+  const GridPoint& a = grid[tets[t][0]];
+  const GridPoint& b = grid[tets[t][1]];
+  std::int64_t squared = 0;
+  for (int axis = 0; axis < 3; ++axis) squared += (a[axis] - b[axis]) * (a[axis] - b[axis]);
+  // squared = (3 - type) * 4^(grid_bits - k) at level 3k + type.
+  const int type = kinds[t].type();
+  const auto power = static_cast<std::uint64_t>(squared / (3 - type));
+  const int k = grid_bits - std::countr_zero(power) / 2;
+  return 3 * k + type;
 }
 
 int TetMesh::face_towards(TetId t, TetId neighbour) const {

@@ -1,5 +1,6 @@
 #include <meccano/volumetric_approximation.hpp>
 
+#include <meccano/cube_meccano.hpp>
 #include <meccano/error.hpp>
 
 #include "topology_helpers.hpp"
@@ -186,6 +187,11 @@ bool intersects(const TetMesh& mesh, const TriangleBVH& surface, TetId t) {
 
 }  // namespace
 
+double growth_reach(const MeccanoGrid& meccano, double resolution) {
+  const int level = level_for_resolution(meccano, resolution);
+  return std::max(resolution, longest_edge_at_level(meccano, level - level % 3));
+}
+
 ChildCallback region_follows_children(std::vector<TetRegion*> regions) {
   return [regions = std::move(regions)](TetId parent, TetId /*child1*/) {
     for (TetRegion* region : regions) region->push_back((*region)[parent]);
@@ -198,6 +204,7 @@ TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const Vo
     throw InputError("the resolution l_r must be positive (got " + std::to_string(options.resolution) + ")");
 
   // Step 1: refine the tets meeting S until they are shorter than l_r.
+  stats.level = level_for_resolution(mesh.meccano, options.resolution);
   TetRegion region(mesh.tets.size(), 0);
   const auto initial = mesh.num_tets();
 #pragma omp parallel for schedule(dynamic, 256)
@@ -210,7 +217,7 @@ TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const Vo
   for (;;) {
     marked.clear();
     for (TetId t = 0; t < mesh.num_tets(); ++t)
-      if (region[t] && mesh.longest_edge(t) >= options.resolution) marked.push_back(t);
+      if (region[t] && mesh.level(t) < stats.level) marked.push_back(t);
     if (marked.empty()) break;
     ++stats.refinement_passes;
     retest.clear();
@@ -245,15 +252,21 @@ void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& o
                     std::vector<TetRegion*> other_regions, const TriangleBVH* surface) {
   const ChildCallback follow_others = region_follows_children(std::move(other_regions));
   // Steps 2 and 3: grow into a ball with axis-parallel boundary faces. A tet the growth wants that is
-  // not finer than l_r, or (given S) has a node farther than l_r from S, is bisected instead of added:
+  // coarser than V_M's level, or (given S) has a node beyond the reach, is bisected instead of added:
   // adding coarse tets would pull far-away, coarse parts of the mesh into V_M (each brings new oblique
-  // faces and pinched nodes further out), and far nodes would become nodes of S_M far from S.
-  // Where the growth must cross the offset at distance l_r, bisection alone never ends: a tet straddling
-  // it keeps a child that straddles it, and the front refines without limit. So a tet finer than
-  // l_r / 16 is added when its nodes are within the band 1.125 l_r of S, and the growth fails if it
-  // needs one that reaches beyond the band.
-  const double finest_edge = options.resolution * finest_growth_edge;
-  const double band = options.resolution * growth_band;
+  // faces and pinched nodes further out), and far nodes would become nodes of S_M far from S. The
+  // reach is at least the diagonal of the level's cubes, which the axis-parallel growth completes:
+  // with l_r alone, a level finer than the cubes' (tets shorter than l_r in cubes wider than it)
+  // bisected its way out to l_r / 16 all around S, for up to 3 times the tets and tangles that took
+  // five times the smoothing (doc/benchmarks.md, "Predictable cost").
+  // Where the growth must cross the offset at the reach, bisection alone never ends: a tet straddling
+  // it keeps a child that straddles it, and the front refines without limit. So a tet 16 times finer
+  // than V_M's is added when its nodes are within the band 1.125 × reach of S, and the growth fails if
+  // it needs one that reaches beyond the band.
+  const int target_level = level_for_resolution(mesh.meccano, options.resolution);
+  stats.reach = growth_reach(mesh.meccano, options.resolution);
+  const double reach = stats.reach;
+  const double band = reach * growth_band;
   std::vector<double> distance_to_surface;  // per vertex; NaN: not computed yet
   auto farthest_node = [&](TetId t) {
     distance_to_surface.resize(mesh.points.size(), std::numeric_limits<double>::quiet_NaN());
@@ -270,20 +283,21 @@ void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& o
     std::int64_t added = 0;
     for (TetId t : wanted) {
       if (region[t]) continue;
-      const double edge = mesh.longest_edge(t);
-      const double farthest = surface && edge < options.resolution ? farthest_node(t) : 0.0;
-      if (edge >= options.resolution || (farthest >= options.resolution && edge >= finest_edge)) {
+      const int level = mesh.level(t);
+      const double farthest = surface && level >= target_level ? farthest_node(t) : 0.0;
+      if (level < target_level || (farthest >= reach && level < target_level + finest_growth_levels)) {
         coarse.push_back(t);
         continue;
       }
       if (farthest >= band) {
         const Eigen::Vector3d at = mesh.points[mesh.tets[t][0]];
-        throw MeshingError("the volumetric approximation cannot be grown into a ball within l_r of the surface "
+        throw MeshingError("the volumetric approximation cannot be grown into a ball within reach of the surface "
                            "near (" + std::to_string(at.x()) + ", " + std::to_string(at.y()) + ", " +
-                           std::to_string(at.z()) + "): the ball must reach " + std::to_string(farthest / options.resolution) +
-                           " l_r from it; a smaller l_r resolves this part of the surface");
+                           std::to_string(at.z()) + "): the ball must reach " + std::to_string(farthest / reach) +
+                           " times the reach " + std::to_string(reach) +
+                           " from it; a smaller l_r resolves this part of the surface");
       }
-      stats.band_tets += farthest >= options.resolution;
+      stats.band_tets += farthest >= reach;
       region[t] = 1;
       ++added;
     }

@@ -213,6 +213,18 @@ std::string finer_resolutions(const meccano::InsertionResult& result, double ask
 }
 
 // Writes the case's surfaces as OBJ files and prints the meccano-immerse command that inserts them.
+// ", 73712 tets, 16 sweeps, fallback at sweep 21, 12 band tets, side retry": what an insertion cost.
+std::string cost_of(const meccano::InsertionResult& result) {
+  std::ostringstream out;
+  out << ", " << result.mesh.num_tets() << " tets, " << result.smoothing.sweeps.size() << " sweeps";
+  if (result.smoothing.fallback_sweep > 0) out << ", fallback at sweep " << result.smoothing.fallback_sweep;
+  std::int64_t band = 0;
+  for (const auto& inserted : result.surfaces) band += inserted.volumetric_stats.band_tets;
+  if (band > 0) out << ", " << band << " band tets";
+  if (!result.side_retry.empty()) out << ", side retry";
+  return out.str();
+}
+
 void dump_case(const std::string& directory, int c, const std::vector<TriangleSurface>& surfaces, double resolution) {
   std::ostringstream command;
   command << std::setprecision(17) << "meccano-immerse --box 0,0,0,1,1,1 --resolution " << resolution;
@@ -275,6 +287,7 @@ int main(int argc, char** argv) {
     Outcome outcome = Outcome::accepted_ok;
     std::string detail;
     double seconds = 0.0;
+    std::string cost;  // of an insertion that returned: tets, sweeps, and the rescues it needed
     try {
       meccano::validate_surfaces(surfaces, box);
     } catch (const meccano::InputError& error) {
@@ -290,6 +303,7 @@ int main(int argc, char** argv) {
         const meccano::InsertionResult result =
             meccano::insert_surfaces(meccano::make_cube_meccano(box, 0), surfaces, insertion);
         detail = defects_of(result, surfaces);
+        cost = cost_of(result);
         if (!detail.empty()) {
           outcome = Outcome::accepted_invalid;
         } else if (!result.finer_retries.empty()) {
@@ -307,7 +321,7 @@ int main(int argc, char** argv) {
     ++counts[{outcome, outcome == Outcome::accepted_ok ? std::string() : reason_of(detail)}];
     std::cout << "case " << c << ": " << surface_count << " surface(s), l_r = 1/" << std::lround(1.0 / resolution)
               << ", " << outcome_name(outcome);
-    if (outcome != Outcome::rejected) std::cout << " (" << one_decimal(seconds) << " s)";
+    if (outcome != Outcome::rejected) std::cout << " (" << one_decimal(seconds) << " s" << cost << ")";
     if (!detail.empty()) std::cout << ": " << detail;
     std::cout << std::endl;
   }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -200,6 +201,32 @@ TriangleSurface perturbed(TriangleSurface surface, double amplitude, std::uint64
 TriangleSurface scaled_into(TriangleSurface surface, const Box& box) {
   for (Vector3d& p : surface.points) p = box.min + p.cwiseProduct(box.extent());
   return surface;
+}
+
+double largest_extent(const TriangleSurface& surface) {
+  Vector3d lo = surface.points.front(), hi = lo;
+  for (const Vector3d& p : surface.points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  return (hi - lo).maxCoeff();
+}
+
+Box box_around(const TriangleSurface& surface, double margin) {
+  Box box{surface.points.front(), surface.points.front()};
+  for (const Vector3d& p : surface.points) {
+    box.min = box.min.cwiseMin(p);
+    box.max = box.max.cwiseMax(p);
+  }
+  const double grow = margin * box.extent().maxCoeff();
+  box.min.array() -= grow;
+  box.max.array() += grow;
+  return box;
+}
+
+std::string shared_fault(const std::string& file) {
+  const std::filesystem::path path = std::filesystem::path(MECCANO_FAULTS_DIR) / file;
+  return std::filesystem::exists(path) ? path.string() : std::string();
 }
 
 std::vector<SurfaceCase> surface_cases(int n, bool with_perturbed) {

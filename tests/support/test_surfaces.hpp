@@ -67,4 +67,13 @@ TriangleSurface perturbed(TriangleSurface surface, double amplitude, std::uint64
 // Maps the unit cube onto `box` (affinely, per axis).
 TriangleSurface scaled_into(TriangleSurface surface, const Box& box);
 
+// Real surfaces: the largest side of a surface's bounding box (its "extent"), and that box enlarged on
+// every side by `margin` times the extent (the box a fault is meshed in by the tests and benchmarks).
+double largest_extent(const TriangleSurface& surface);
+Box box_around(const TriangleSurface& surface, double margin = 0.1);
+
+// The shared fault file of that name (../shared/data/faults beside the checkout, GOCAD TSurf, UTM
+// metres), or an empty string when the data is not there: tests that need it skip.
+std::string shared_fault(const std::string& file);
+
 }  // namespace meccano::testing

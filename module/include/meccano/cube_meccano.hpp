@@ -21,4 +21,13 @@ std::array<int, 3> cells_for_box(const Box& box);
 TetMesh make_cube_meccano(const Box& box, const std::array<int, 3>& cells, int level = 0);
 TetMesh make_cube_meccano(const Box& box, int level = 0);
 
+// The longest physical edge of any tet of bisection level `level` (TetMesh::level) in the undeformed
+// meccano. Every cell is cut alike and the tets of level 3k + j are those of level j scaled by 2^-k, so
+// one cell refined j times tells.
+double longest_edge_at_level(const MeccanoGrid& meccano, int level);
+
+// The coarsest level whose tets all have their longest edge below `resolution` (> 0), so that refining
+// every tet meeting a surface to it satisfies eq. 1 (l_T < l_r) with one level throughout.
+int level_for_resolution(const MeccanoGrid& meccano, double resolution);
+
 }  // namespace meccano

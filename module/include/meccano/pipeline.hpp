@@ -89,6 +89,7 @@ struct InsertionResult {
   QualitySummary quality_before_smoothing;  // right after projection (tets may be inverted)
   QualitySummary quality_after_smoothing;
   double seconds = 0.0;                     // the whole insertion
+  std::int64_t estimated_tets = 0;          // estimate_tets before any refinement, for the l_r asked
   std::string side_retry;  // why the insertion was run again with S_M on the other side (empty if not)
   std::vector<std::string> finer_retries;  // why it was run again with finer l_r for some surfaces, in order
 };

@@ -99,6 +99,10 @@ struct TetMesh {
   std::array<Eigen::Vector3d, 4> tet_points(TetId t) const;
   // Longest physical edge, l_T of the paper.
   double longest_edge(TetId t) const;
+  // Bisection level: 0 for the Kuhn tets of a meccano cell, +1 per bisection. Read off the computational
+  // length of the refinement edge (a cube diagonal, face diagonal or cube edge of a cube 2^-k cells wide
+  // at levels 3k, 3k+1, 3k+2), so it needs no stored history.
+  int level(TetId t) const;
   // Index (0..3) of the face of `t` shared with `neighbour`, or -1.
   int face_towards(TetId t, TetId neighbour) const;
 };

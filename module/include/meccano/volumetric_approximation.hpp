@@ -2,30 +2,38 @@
 //
 // Input    a conforming TetMesh (the cube meccano, possibly refined for other surfaces), S through its
 //          TriangleBVH, and the resolution l_r > 0.
-// Steps    1. V_M = the tets that intersect S. While some tet of V_M has l_T >= l_r (eq. 1, l_T the
-//             longest edge), bisect those tets (Kossaczky, conforming closure) and keep in V_M the
-//             children that still intersect S.
+// Steps    1. V_M = the tets that intersect S. While some tet of V_M is coarser than the level L of
+//             l_r (level_for_resolution: the coarsest bisection level whose tets all have l_T < l_r,
+//             eq. 1 with l_T the longest edge), bisect those tets (Kossaczky, conforming closure) and
+//             keep in V_M the children that still intersect S. Refining by level rather than by each
+//             tet's own l_T gives V_M one level throughout: in cells that are not cubes, tets of one
+//             level differ in l_T, and a V_M of two levels grew and tangled far more (doc/benchmarks.md,
+//             "Predictable cost").
 //          2. Grow V_M into a topological ball: add the star (all tets of M around it) of every
 //             boundary node whose link in V_M is not a disk. The node Euler test of eq. 2,
 //             χ = n_E − n_F + n_T = 1, is necessary; the link must also be connected and its triangles
 //             around each link vertex must form one fan (eq. 2 alone accepts pinched links). Cavities
 //             (components of the complement that V_M encloses) are filled.
-//          In steps 2 and 3 a tet to be added whose longest edge is l_r or more, or with a node farther
-//          than l_r from S, is bisected instead (and the step repeats), so V_M stays made of tets
-//          finer than l_r with every node within l_r of S. Where the growth has to cross the offset at
-//          distance l_r, that bisection would never end (a tet straddling the offset always has a child
-//          straddling it): a tet finer than l_r / 16 is added if its nodes are within the band
-//          1.125 l_r, and the growth fails if it needs one reaching beyond the band.
+//          In steps 2 and 3 a tet to be added that is coarser than level L, or with a node farther than
+//          the reach from S, is bisected instead (and the step repeats), so V_M stays made of tets of
+//          level L or finer with every node within reach of S. The reach (growth_reach) is l_r, or
+//          the diagonal of the cubes of L's level (the cubes whose faces are the axis-parallel faces
+//          of level L, which step 3 completes) when that is longer: at most √3 l_T(L) < √3 l_r.
+//          Where the growth has to cross the offset at the reach, that bisection would never end (a
+//          tet straddling the offset always has a child straddling it): a tet 16 times finer than
+//          level L (finest_growth_levels) is added if its nodes are within the band 1.125 × reach,
+//          and the growth fails if it needs one reaching beyond the band.
 //          3. Grow V_M until every boundary face lies on a coordinate plane in computational
 //             coordinates, by adding the tet across each face that does not; step 2 is then re-run,
 //             until neither step changes V_M. If V_M then has disk links everywhere but a boundary
 //             that is not a sphere (a handle), it is thickened by the stars of its boundary nodes and
 //             the steps repeat.
-// Output   per-tet membership of V_M, and counts of what each step did.
+// Output   per-tet membership of V_M, and counts of what each step did (with L and the reach).
 // Invariants on return (check_ball): V_M is face-connected, every boundary node has a disk link, the
 //          boundary is one closed 2-manifold with Euler characteristic 2, every boundary face is
-//          axis-parallel; every tet meeting S is in V_M and has l_T < l_r; every node of V_M is within
-//          l_r of S, or within 1.125 l_r at a node of a tet added in the band (counted in band_tets).
+//          axis-parallel; every tet meeting S is in V_M and has level L or finer, hence l_T < l_r;
+//          every node of V_M is within the reach of S, or within 1.125 × reach at a node of a tet added
+//          in the band (counted in band_tets).
 // Errors   InputError for l_r <= 0; MeshingError if V_M cannot be made a ball within the pass limit, or
 //          only by reaching beyond the band (the message names where).
 #pragma once
@@ -39,10 +47,15 @@
 
 namespace meccano {
 
-// Where V_M's growth crosses the offset of S at distance l_r, it stops bisecting at tets finer than
-// finest_growth_edge * l_r and adds them if their nodes are within growth_band * l_r of S (steps 2-3).
-inline constexpr double finest_growth_edge = 1.0 / 16.0;
+// Where V_M's growth crosses the offset of S at the reach, it stops bisecting at tets finest_growth_levels
+// finer than V_M's level (4 halvings of every edge) and adds them if their nodes are within
+// growth_band × reach of S (steps 2-3).
+inline constexpr int finest_growth_levels = 12;
 inline constexpr double growth_band = 1.125;
+
+// How far from S the nodes of V_M may lie (steps 2-3): max(l_r, the diagonal of the cubes of the level
+// of l_r), at most √3 l_r.
+double growth_reach(const MeccanoGrid& meccano, double resolution);
 
 // Per-tet flag of a region of the mesh (V_M); kept in step with refinement by region_follows_children.
 using TetRegion = std::vector<std::uint8_t>;
@@ -57,6 +70,8 @@ struct VolumetricOptions {
 };
 
 struct VolumetricStats {
+  int level = 0;                       // L: the bisection level of V_M's tets (level_for_resolution)
+  double reach = 0.0;                  // growth_reach: how far from S V_M's nodes may lie
   int refinement_passes = 0;
   std::int64_t bisections = 0;
   std::int64_t intersection_tests = 0;
@@ -66,7 +81,7 @@ struct VolumetricStats {
   std::int64_t axis_tets = 0;          // tets added to make the boundary axis-parallel
   int thickening_layers = 0;           // layers added to close handles the link test cannot see
   int growth_refinements = 0;          // times the growth bisected tets (coarse, or with nodes beyond l_r)
-  std::int64_t band_tets = 0;          // tets finer than l_r / 16 added with a node beyond l_r (within the band)
+  std::int64_t band_tets = 0;          // tets of the finest growth level added with a node beyond the reach
   int growth_passes = 0;
   std::int64_t tets = 0;               // tets of V_M at the end
 };

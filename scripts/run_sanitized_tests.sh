@@ -35,7 +35,7 @@ export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 
 unit='SurfaceIo|SurfaceWeld|MshVersions|SurfaceTopology|GeometryChecks|Geometry\.|Bisection|CubeMeccano'
 unit+='|BallCheck|GrowIntoBall|VolumetricApproximation|SurfaceApproximation\.|Parameterization|Projection\.'
-unit+='|Distortion|QualitySummary|DihedralAngles|HistogramCsv|JsonWriter|MeshIo|SurfaceInterfaces|CliTest'
+unit+='|Creases|Distortion|QualitySummary|DihedralAngles|HistogramCsv|JsonWriter|MeshIo|SurfaceInterfaces|CliTest'
 unit+='|Smoothing\.(UntanglesAScrambled|UntanglesTowardsTheEquilateral|FallsBackToTheEquilateral)|InsertionOptions\.SurfacesTooClose'
 coarse='(VolumetricOnSurface|SurfaceApproximationOn|ProjectionOn|SmoothingOn)\..*unit_cube_lr16$'
 excluded='ReferenceGmsh'

@@ -5,6 +5,7 @@
 #include <meccano/error.hpp>
 #include <meccano/geometry.hpp>
 #include <meccano/pipeline.hpp>
+#include <meccano/volumetric_approximation.hpp>
 
 #include <test_surfaces.hpp>
 
@@ -12,6 +13,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 namespace meccano {
@@ -134,8 +136,10 @@ TEST(InsertionOptions, ProgressReportsEveryStage) {
         << stage;
 }
 
-// Two tilted patches 0.03 apart: at l_r = 1/16 each V_M reaches the other surface and S_M cannot be
-// healed; the insertion retries both at l_r = 1/32, where they separate. With no retries it fails.
+// Two tilted patches 0.03 apart vertically (0.0294 along their normal): at l_r = 1/16 each V_M reaches
+// the other surface and S_M cannot be healed. The gap decides the first finer l_r: half of 1/16 would
+// leave S_M within growth_band x reach = 0.035 of its surface, more than the gap, so both go at once to
+// 1/64, where both bands fit, in one retry. With no retries it fails.
 TEST(InsertionOptions, SurfacesTooCloseForTheResolutionAreRetriedFiner) {
   auto patch = [](double offset, const char* name) {
     return testing::graph_patch([offset](double x, double) { return 0.5 + offset + 0.2 * (x - 0.5); }, {0.3, 0.7},
@@ -146,11 +150,16 @@ TEST(InsertionOptions, SurfacesTooCloseForTheResolutionAreRetriedFiner) {
   const InsertionResult result = insert(surfaces, options);
   ASSERT_EQ(result.finer_retries.size(), 1u);
   EXPECT_NE(result.finer_retries[0].find("could not be healed"), std::string::npos) << result.finer_retries[0];
-  for (const SurfaceInsertion& inserted : result.surfaces) EXPECT_EQ(inserted.resolution, options.resolution / 2);
+  const double gap = 0.03 / std::hypot(1.0, 0.2);
+  EXPECT_GT(growth_band * growth_reach(result.mesh.meccano, options.resolution / 2), gap);
+  for (const SurfaceInsertion& inserted : result.surfaces) {
+    EXPECT_EQ(inserted.resolution, options.resolution / 4);
+    EXPECT_LT(growth_band * growth_reach(result.mesh.meccano, inserted.resolution), gap);
+  }
   EXPECT_TRUE(result.smoothing.untangled());
   const std::string report = insertion_report_json(result, Stage::smoothing);
   EXPECT_NE(report.find("\"finer_retries\""), std::string::npos);
-  EXPECT_NE(report.find("\"resolution\": 0.03125"), std::string::npos) << report;
+  EXPECT_NE(report.find("\"resolution\": 0.015625"), std::string::npos) << report;
 
   options.finer_retries = 0;
   EXPECT_THROW(insert(surfaces, options), MeshingError);

@@ -10,7 +10,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <utility>
 #include <vector>
 
 namespace meccano {
@@ -100,6 +103,53 @@ TEST(Projection, HausdorffDistanceShrinksAsTheResolutionHalves) {
     const double rate = std::log2(distances[i - 1] / distances[i]);
     EXPECT_GT(rate, 1.0) << "level " << i << ": " << distances[i - 1] << " -> " << distances[i];
   }
+}
+
+// A roof folded by 2 atan(0.3) = 33 degrees along x = 0.5. Followed (creases.hpp), the fold is a path of
+// S_M edges: its nodes stay on the ridge through smoothing, and every face lies on one of the two planes
+// but some within two cells of the rim (nodes joined to a rim node stay off the ridge). Not followed, faces across
+// the ridge are chords tilted by up to 16 degrees.
+TEST(Creases, ARoofKeepsItsRidgeThroughSmoothing) {
+  const TriangleSurface roof = testing::graph_patch(
+      [](double x, double y) { return 0.45 + 0.3 * std::abs(x - 0.5) + 0.02 * y; }, {0.1, 0.9}, {0.1, 0.9}, 16, "roof");
+  const Eigen::Vector3d left = Eigen::Vector3d(0.3, -0.02, 1).normalized();
+  const Eigen::Vector3d right = Eigen::Vector3d(-0.3, -0.02, 1).normalized();
+  const auto faces_off_both_planes = [&](double crease_angle) {
+    InsertionOptions options;
+    options.resolution = 1.0 / 16;
+    options.projection.crease_angle = crease_angle;
+    const InsertionResult result = insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {&roof, 1}, options);
+    EXPECT_TRUE(verify_mesh(result.mesh).ok());
+    const SurfaceProjection& projection = result.surfaces[0].projection;
+    for (std::size_t i = 0; i < projection.nodes.size(); ++i) {
+      if (projection.creases.line_of[i] < 0) continue;
+      const Eigen::Vector3d& x = result.mesh.points[projection.nodes[i]];
+      EXPECT_NEAR(x.x(), 0.5, 1e-12) << "crease node " << projection.nodes[i] << " left the ridge";
+      EXPECT_NEAR(x.z(), 0.45 + 0.02 * x.y(), 1e-12);
+    }
+    // Faces off both planes; with the ridge followed, all of them within two cells of the rim.
+    int off = 0;
+    const std::vector<SurfaceInterface> interfaces = surface_interfaces(result);
+    for (const InterfaceFace& face : interfaces[0].faces) {
+      if (std::min(std::acos(std::min(1.0, face.normal.dot(left))), std::acos(std::min(1.0, face.normal.dot(right)))) < 1e-6)
+        continue;
+      ++off;
+      double from_rim = 1.0;
+      for (VertexId v : face.vertices) {
+        const Eigen::Vector3d& x = result.mesh.points[v];
+        from_rim = std::min({from_rim, x.x() - 0.1, 0.9 - x.x(), x.y() - 0.1, 0.9 - x.y()});
+      }
+      if (crease_angle < 180) EXPECT_LT(from_rim, 2.0 * options.resolution) << "a face across the ridge inside S";
+    }
+    return std::pair{off, projection.creases.stats};
+  };
+  const auto [followed_off, followed] = faces_off_both_planes(default_crease_angle);
+  const auto [ignored_off, ignored] = faces_off_both_planes(180);
+  EXPECT_EQ(followed.lines, 1);
+  EXPECT_NEAR(followed.sharpest, 2 * std::atan(0.3) * 180 / std::numbers::pi, 1.0);
+  EXPECT_GT(followed.nodes, 6);
+  EXPECT_EQ(ignored.lines, 0);
+  EXPECT_GT(ignored_off, 4 * followed_off + 10) << "the fold no longer cuts S_M's faces: the test lost its point";
 }
 
 }  // namespace

@@ -67,6 +67,9 @@ Options:
                            projection     S_M's nodes moved onto the surfaces; tets may be inverted
                                           (this output only)
                            smoothing      untangled and smoothed: the result
+  --crease-angle DEG       S_M follows every crease of a surface sharper than DEG degrees (the angle
+                           between the normals of the two triangles of an edge): a path of interface
+                           edges runs along it and its nodes stay on it (default 12; 180: none)
   --side RULE              the side of each surface S_M is built on (S's normals point to the
                            positive side): positive (default) or negative first, the other side if
                            healing or untangling fails there; positive-only or negative-only never
@@ -96,10 +99,11 @@ Options:
                            .mesh  Medit, references named in comment lines (# Triangles ref 7 ...)
   --msh-version V          4.1 (default) or 2.2 for older readers; applies to the .msh outputs that
                            follow it
-  --finer-retries N        a surface whose insertion fails (V_M not within l_r of it, S_M not healed,
-                           or tets next to it still inverted on both sides) is inserted again at half
-                           its l_r, at most N times (default 2; 0: never); the report's finer_retries
-                           and each surface's resolution say what happened
+  --finer-retries N        a surface whose insertion fails (V_M not within reach of it, S_M not
+                           healed, or tets next to it still inverted on both sides) is inserted again
+                           at half its l_r, or finer if its gap to another surface or the box needs
+                           it, at most N times (default 2; 0: never); the report's finer_retries and
+                           each surface's resolution say what happened
   --max-tets N             refuse to run when the estimated tet count exceeds N (default: 16 GiB at
                            about 280 bytes per tet, 61 million tets): a tiny --resolution fails at once
                            instead of exhausting memory
@@ -181,6 +185,7 @@ struct Options {
   std::optional<double> resolution;
   std::optional<std::string> stage;
   meccano::SideRule side_rule = meccano::SideRule::positive_first;
+  double crease_angle = meccano::default_crease_angle;
   meccano::SmoothingOptions smoothing;
   std::optional<int> threads;
   std::int64_t max_tets = meccano::default_max_tets;
@@ -253,6 +258,10 @@ Options parse_options(int argc, char** argv) {
       const double tolerance = parse_numbers(arg, value(), 1)[0];
       if (tolerance < 0) throw UsageError("--weld-tolerance must not be negative");
       options.reading.weld_tolerance = tolerance;
+    } else if (arg == "--crease-angle") {
+      const double angle = parse_numbers(arg, value(), 1)[0];
+      if (!(angle > 0.0 && angle <= 180.0)) throw UsageError("--crease-angle must be above 0 and at most 180 degrees");
+      options.crease_angle = angle;
     } else if (arg == "--split-parts") {
       options.split_parts = true;
     } else if (arg == "--resolution") {
@@ -400,6 +409,7 @@ int run(const Options& options) {
   insertion.resolution = options.resolution.value_or(0.0);
   insertion.last_stage = options.stage ? *stage_named(*options.stage) : meccano::Stage::smoothing;
   insertion.approximation.side_rule = options.side_rule;
+  insertion.projection.crease_angle = options.crease_angle;
   insertion.smoothing = options.smoothing;
   insertion.max_tets = options.max_tets;
   insertion.finer_retries = options.finer_retries;

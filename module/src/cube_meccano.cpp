@@ -113,8 +113,7 @@ int level_for_resolution(const MeccanoGrid& meccano, double resolution) {
   int level = std::max(0, 3 * static_cast<int>(std::floor(std::log2(diagonal / resolution))) - 3);
   while (level > 0 && longest_edge_at_level(meccano, level - 1) < resolution) --level;
   while (longest_edge_at_level(meccano, level) >= resolution) {
-    // Computational coordinates have grid_bits bits per cell edge, three levels per bit.
-    if (++level > 3 * grid_bits - 12) {
+    if (++level > finest_level) {
       std::ostringstream message;
       message << "the resolution l_r = " << resolution << " is too fine for the meccano's cells (edge "
               << meccano.cell_size.maxCoeff() << "): at most " << grid_bits - 4 << " halvings of a cell edge";

@@ -383,6 +383,22 @@ int TriangleBVH::build(int begin, int end, const std::vector<Eigen::Vector3d>& c
   return index;
 }
 
+double surface_distance(const TriangleSurface& a, const TriangleBVH& b) {
+  // An upper bound from the vertices first, so that each triangle looks only at b's triangles within it.
+  double best = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& p : a.points) best = std::min(best, b.closest_point(p).squared_distance);
+  best = std::sqrt(best);
+  for (const auto& [i, j, k] : a.triangles) {
+    const Triangle3 triangle{a.points[i], a.points[j], a.points[k]};
+    Eigen::AlignedBox3d box(triangle[0]);
+    box.extend(triangle[1]).extend(triangle[2]);
+    box.min().array() -= best;
+    box.max().array() += best;
+    b.for_each_triangle_overlapping(box, [&](int t) { best = std::min(best, triangle_distance(triangle, b.triangle(t))); });
+  }
+  return best;
+}
+
 ClosestPoint TriangleBVH::closest_point(const Eigen::Vector3d& x) const {
   ClosestPoint best;
   best.squared_distance = std::numeric_limits<double>::infinity();

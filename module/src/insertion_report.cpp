@@ -51,6 +51,11 @@ void write_surface(JsonWriter& json, const SurfaceInsertion& inserted, Stage las
     json.key("nodes").value(p.nodes).key("rim_nodes").value(p.rim_nodes);
     json.key("largest_move").value(p.largest_move).key("largest_distance_after").value(p.largest_distance_after);
     json.key("inverted_tets").value(p.inverted_tets);
+    json.key("creases").begin_object();
+    json.key("lines").value(p.creases.lines).key("crossings").value(p.creases.crossings);
+    json.key("nodes").value(p.creases.nodes).key("refused").value(p.creases.refused);
+    json.key("straddling").value(p.creases.straddling);
+    json.key("sharpest_deg").value(p.creases.sharpest).end_object();
     json.key("seconds").value(inserted.projection_seconds).end_object();
   }
   json.end_object();
@@ -60,6 +65,7 @@ void write_smoothing(JsonWriter& json, const SmoothingStats& s, double seconds) 
   json.key("smoothing").begin_object();
   json.key("inner_nodes").value(s.inner_nodes).key("box_nodes").value(s.box_nodes);
   json.key("surface_nodes").value(s.surface_nodes).key("rim_nodes").value(s.rim_nodes);
+  json.key("crease_nodes").value(s.crease_nodes);
   json.key("active_tets").value(s.active_tets).key("colours").value(s.colours);
   json.key("inverted_before").value(s.inverted_before).key("inverted_after").value(s.inverted_after);
   json.key("untangling_sweeps").value(s.untangling_sweeps).key("fallback_sweep").value(s.fallback_sweep);

@@ -1,5 +1,6 @@
 #include <meccano/pipeline.hpp>
 
+#include <meccano/cube_meccano.hpp>
 #include <meccano/error.hpp>
 #include <meccano/mesh_check.hpp>
 
@@ -8,7 +9,9 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <limits>
 #include <sstream>
 
 namespace meccano {
@@ -136,12 +139,12 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
     SurfaceInsertion& inserted = result.surfaces[s];
     const auto start = std::chrono::steady_clock::now();
     inserted.projection = project_onto_surface(result.mesh, inserted.volumetric, s, inserted.healing_stats.side,
-                                               surfaces[s], trees[s]);
+                                               surfaces[s], trees[s], options.projection);
     inserted.projection_seconds = seconds_since(start);
     const auto& p = inserted.projection.stats;
-    report(options, "projection ", inserted.name, ": ", p.nodes, " nodes (", p.rim_nodes, " on the rim) moved by up to ",
-           p.largest_move, ", now within ", p.largest_distance_after, " of S; ", p.inverted_tets,
-           " tets inverted (smoothing untangles them)");
+    report(options, "projection ", inserted.name, ": ", p.nodes, " nodes (", p.rim_nodes, " on the rim, ",
+           p.creases.nodes, " on ", p.creases.lines, " creases) moved by up to ", p.largest_move, ", now within ",
+           p.largest_distance_after, " of S; ", p.inverted_tets, " tets inverted (smoothing untangles them)");
   }
   const auto check = verify_mesh(result.mesh, {.physical = false});
   if (!check.ok()) throw MeshingError("mesh invalid after the projection stage: " + check.summary());
@@ -156,8 +159,10 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
   result.smoothing_seconds = seconds_since(start);
   const SmoothingStats& smoothing = result.smoothing;
   const SweepRecord last = smoothing.sweeps.empty() ? SweepRecord{} : smoothing.sweeps.back();
-  report(options, "smoothing: ", smoothing.inner_nodes + smoothing.box_nodes + smoothing.surface_nodes + smoothing.rim_nodes,
-         " free nodes (", smoothing.surface_nodes, " on surfaces, ", smoothing.rim_nodes, " on rims), ", smoothing.colours,
+  report(options, "smoothing: ",
+         smoothing.inner_nodes + smoothing.box_nodes + smoothing.surface_nodes + smoothing.rim_nodes + smoothing.crease_nodes,
+         " free nodes (", smoothing.surface_nodes, " on surfaces, ", smoothing.rim_nodes, " on rims, ",
+         smoothing.crease_nodes, " on creases), ", smoothing.colours,
          " colours; ", smoothing.inverted_before, " inverted tets before, ", smoothing.inverted_after, " after ",
          smoothing.sweeps.size(), " sweeps (untangled after ", smoothing.untangling_sweeps,
          smoothing.fallback_sweep > 0 ? ", towards the equilateral target from sweep " + std::to_string(smoothing.fallback_sweep)
@@ -257,15 +262,52 @@ InsertionResult insert_on_either_side(const TetMesh& mesh, std::span<const Trian
 
 }  // namespace
 
-std::int64_t estimate_tets(std::int64_t meccano_tets, std::span<const TriangleSurface> surfaces, double resolution) {
-  constexpr double tets_per_area = 185.0;  // per l_r², see pipeline.hpp
-  double area = 0.0;
-  for (const TriangleSurface& surface : surfaces)
-    for (const auto& [a, b, c] : surface.triangles)
-      area += 0.5 * (surface.points[b] - surface.points[a]).cross(surface.points[c] - surface.points[a]).norm();
-  const double layer = tets_per_area * area / (resolution * resolution);
-  // Saturates instead of overflowing: l_r = 1e-300 is an estimate too.
-  const double total = static_cast<double>(meccano_tets) + layer;
+namespace {
+
+// The length of a surface's rim: its edges used by one triangle.
+double rim_length(const TriangleSurface& surface) {
+  std::vector<std::array<int, 2>> edges;
+  edges.reserve(3 * surface.triangles.size());
+  for (const auto& triangle : surface.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const auto [low, high] = std::minmax(triangle[k], triangle[(k + 1) % 3]);
+      edges.push_back({low, high});
+    }
+  std::ranges::sort(edges);
+  double length = 0.0;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if (j - i == 1) length += (surface.points[edges[i][1]] - surface.points[edges[i][0]]).norm();
+    i = j;
+  }
+  return length;
+}
+
+}  // namespace
+
+std::int64_t estimate_tets(const MeccanoGrid& meccano, std::int64_t meccano_tets,
+                           std::span<const TriangleSurface> surfaces, double resolution) {
+  // V_M covers S with the cubes of its level: a plane with unit normal n crosses
+  // |n_x| / (h_y h_z) + |n_y| / (h_x h_z) + |n_z| / (h_x h_y) cubes of sides h per unit area, and the
+  // rim adds about one cube per cube width. Tets per cube crossed and per rim cube, by level type (the
+  // levels 3k, 3k+1, 3k+2 cut a cube into 6, 12 and 24 tets): fitted on 13 real and synthetic faults and
+  // two test surfaces at E/25 to E/100, all within 34 % (doc/benchmarks.md, "Predictable cost").
+  static constexpr std::array<double, 3> tets_per_cube = {27.5, 33.7, 61.1};
+  static constexpr std::array<double, 3> tets_per_rim_cube = {85.6, 111.6, 159.5};
+  const int level = level_for_resolution(meccano, resolution);
+  const Eigen::Vector3d h = std::ldexp(1.0, -(level / 3)) * meccano.cell_size;
+  const Eigen::Vector3d per_area(1.0 / (h.y() * h.z()), 1.0 / (h.x() * h.z()), 1.0 / (h.x() * h.y()));
+  double cubes = 0.0, rim_cubes = 0.0;
+  for (const TriangleSurface& surface : surfaces) {
+    for (const auto& [a, b, c] : surface.triangles) {
+      const Eigen::Vector3d area = 0.5 * (surface.points[b] - surface.points[a]).cross(surface.points[c] - surface.points[a]);
+      cubes += area.cwiseAbs().dot(per_area);
+    }
+    rim_cubes += rim_length(surface) / std::cbrt(h.prod());
+  }
+  const double total = static_cast<double>(meccano_tets) + tets_per_cube[level % 3] * cubes +
+                       tets_per_rim_cube[level % 3] * rim_cubes;
   return total < 0x1p62 ? static_cast<std::int64_t>(total) : std::int64_t{1} << 62;
 }
 
@@ -280,25 +322,63 @@ void check_tet_estimate(std::int64_t estimated_tets, std::int64_t max_tets, cons
   throw InputError(message.str());
 }
 
-// The failing surfaces and those close enough to them for their S_M to touch (closer than the sum of
-// both l_r, the reach of the two V_M): a finer l_r for one alone would leave the other's S_M in place.
-std::vector<int> surfaces_to_refine(std::span<const TriangleSurface> surfaces, std::span<const double> resolutions,
-                                    std::vector<int> failing) {
+// How close each surface comes to every other one and to the box sides: the room its V_M has.
+struct Clearances {
+  std::vector<std::vector<double>> between;  // surface distances, symmetric
+  std::vector<double> to_box;
+};
+
+Clearances clearances(std::span<const TriangleSurface> surfaces, const Box& box) {
+  const std::size_t count = surfaces.size();
+  Clearances clearance{std::vector<std::vector<double>>(count, std::vector<double>(count, 0.0)),
+                       std::vector<double>(count, std::numeric_limits<double>::infinity())};
+  for (std::size_t s = 0; s < count; ++s) {
+    for (const Eigen::Vector3d& p : surfaces[s].points)
+      clearance.to_box[s] = std::min({clearance.to_box[s], (p - box.min).minCoeff(), (box.max - p).minCoeff()});
+    const TriangleBVH tree(surfaces[s]);
+    for (std::size_t other = 0; other < s; ++other)
+      clearance.between[s][other] = clearance.between[other][s] = surface_distance(surfaces[other], tree);
+  }
+  return clearance;
+}
+
+// The room two surfaces at these l_r need between them for their S_M to stay apart: each S_M lies
+// within growth_band × its reach of its surface, on one side of it. Measured on stress case 50 of seed 1
+// (two surfaces 0.0052 apart): S_M healed at a reach of 0.0039 (6.3 M tets) and not at 0.0068.
+double room_needed(const MeccanoGrid& meccano, double resolution, double other_resolution) {
+  return growth_band * std::max(growth_reach(meccano, resolution), growth_reach(meccano, other_resolution));
+}
+
+// The failing surfaces and those whose S_M could touch theirs: a finer l_r for one alone would leave
+// the other's S_M in place.
+std::vector<int> surfaces_to_refine(const MeccanoGrid& meccano, const Clearances& clearance,
+                                    std::span<const double> resolutions, std::vector<int> failing) {
   const std::size_t count = failing.size();
   for (std::size_t k = 0; k < count; ++k) {
     const int s = failing[k];
-    const TriangleBVH tree(surfaces[s]);
-    for (int other = 0; other < static_cast<int>(surfaces.size()); ++other) {
-      if (std::ranges::find(failing, other) != failing.end()) continue;
-      const double reach = resolutions[s] + resolutions[other];
-      if (std::ranges::any_of(surfaces[other].points, [&](const Eigen::Vector3d& p) {
-            return tree.closest_point(p).squared_distance < reach * reach;
-          }))
+    for (int other = 0; other < static_cast<int>(resolutions.size()); ++other)
+      if (std::ranges::find(failing, other) == failing.end() &&
+          clearance.between[s][other] < room_needed(meccano, resolutions[s], resolutions[other]))
         failing.push_back(other);
-    }
   }
   std::ranges::sort(failing);
   return failing;
+}
+
+// The next l_r of a surface to refine: half its l_r, or the coarsest finer one that leaves its S_M room
+// between it and the surfaces refined with it, and the box: the gap decides the first finer l_r,
+// instead of halving attempt after attempt.
+double finer_resolution(const MeccanoGrid& meccano, const Clearances& clearance, std::span<const int> refined, int s,
+                        double resolution) {
+  double gap = clearance.to_box[s];
+  for (int other : refined)
+    if (other != s) gap = std::min(gap, clearance.between[s][other]);
+  double finer = resolution / 2.0;
+  for (int level = level_for_resolution(meccano, finer); room_needed(meccano, finer, finer) >= gap; ++level) {
+    if (level >= finest_level) break;  // the surfaces practically touch: the tet limit decides
+    finer = longest_edge_at_level(meccano, level);  // the coarsest l_r of the next level
+  }
+  return finer;
 }
 
 // The insertion at l_r, and where it fails, again with the failing surfaces at half their l_r.
@@ -310,12 +390,13 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
       throw InputError("the resolution l_r must be positive (got " + std::to_string(options.resolution) + ")");
     std::ostringstream what;
     what << "the resolution l_r = " << options.resolution;
-    estimated_tets = estimate_tets(mesh.num_tets(), surfaces, options.resolution);
+    estimated_tets = estimate_tets(mesh.meccano, mesh.num_tets(), surfaces, options.resolution);
     check_tet_estimate(estimated_tets, options.max_tets, what.str());
   }
   const ThreadCount threads(options.threads);
   std::vector<double> resolutions(surfaces.size(), options.resolution);
   std::vector<std::string> failures;  // of the attempts so far
+  Clearances clearance;                // computed at the first failure
   for (int retry = 0;; ++retry) {
     std::vector<int> failing;
     try {
@@ -339,11 +420,15 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
     std::int64_t estimate = mesh.num_tets();
     std::ostringstream finer;
     finer.precision(6);
-    for (int s : surfaces_to_refine(surfaces, resolutions, failing)) {
-      resolutions[s] /= 2.0;
+    if (clearance.to_box.empty()) clearance = clearances(surfaces, mesh.meccano.box);
+    const std::vector<int> refined = surfaces_to_refine(mesh.meccano, clearance, resolutions, failing);
+    const std::vector<double> previous = resolutions;
+    for (int s : refined) {
+      resolutions[s] = finer_resolution(mesh.meccano, clearance, refined, s, previous[s]);
       finer << (finer.tellp() > 0 ? ", " : "") << surfaces[s].name << " at l_r = " << resolutions[s];
     }
-    for (std::size_t s = 0; s < surfaces.size(); ++s) estimate += estimate_tets(0, surfaces.subspan(s, 1), resolutions[s]);
+    for (std::size_t s = 0; s < surfaces.size(); ++s)
+      estimate += estimate_tets(mesh.meccano, 0, surfaces.subspan(s, 1), resolutions[s]);
     if (estimate > options.max_tets) throw MeshingError(all_failures() + "; a finer l_r would exceed the tet limit");
     report(options, "retrying with ", finer.str(), " (", failures.back(), ")");
   }

@@ -10,7 +10,7 @@ namespace meccano {
 
 SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,
                                        const TriangleSurface& surface, const TriangleBVH& tree,
-                                       FloaterWeights weights) {
+                                       const ProjectionOptions& options) {
   // S_M as a disk over the mesh's numbering, oriented like S. Its Floater weights are computed with each
   // node pulled most of the way to its closest point p on S, x' = p + 0.2 (x - p), not on the staircase:
   // the two parameterizations then nearly agree, so φ ∘ φ_M^{-1} moves nodes onto S instead of also
@@ -39,8 +39,9 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
   const auto approximation_corners = matching_corners(approximation, targets, normal);
 
   SurfaceProjection result;
-  result.surface = std::make_unique<ParametricSurface>(target, parameterize_to_square(target, surface_corners, weights));
-  const SquareParameterization own = parameterize_to_square(approximation, approximation_corners, weights);
+  result.surface =
+      std::make_unique<ParametricSurface>(target, parameterize_to_square(target, surface_corners, options.weights));
+  const SquareParameterization own = parameterize_to_square(approximation, approximation_corners, options.weights);
 
   for (const auto& t : triangles) result.nodes.insert(result.nodes.end(), t.begin(), t.end());
   std::sort(result.nodes.begin(), result.nodes.end());
@@ -52,13 +53,10 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
   const auto count = static_cast<std::int64_t>(result.nodes.size());
   result.uv.resize(result.nodes.size());
   result.on_rim.resize(result.nodes.size());
-  std::vector<Eigen::Vector3d> moved(result.nodes.size());
-#pragma omp parallel for schedule(dynamic, 256)
   for (std::int64_t i = 0; i < count; ++i) {
     const VertexId v = result.nodes[i];
     result.uv[i] = own.uv[v];
     result.on_rim[i] = rim[v];
-    moved[i] = result.surface->evaluate(result.surface->locate(own.uv[v]));
   }
   result.orientation = own.orientation;
   for (const auto& t : triangles) {
@@ -66,6 +64,12 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
     for (int k = 0; k < 3; ++k)
       local[k] = static_cast<int>(std::lower_bound(result.nodes.begin(), result.nodes.end(), t[k]) - result.nodes.begin());
   }
+  result.creases = follow_creases(crease_lines(surface, result.surface->parameterization().uv, options.crease_angle),
+                                  result.triangles, result.uv, result.on_rim, result.orientation);
+  stats.creases = result.creases.stats;
+  std::vector<Eigen::Vector3d> moved(result.nodes.size());
+#pragma omp parallel for schedule(dynamic, 256)
+  for (std::int64_t i = 0; i < count; ++i) moved[i] = result.surface->evaluate(result.surface->locate(result.uv[i]));
   for (std::int64_t i = 0; i < count; ++i) {
     const VertexId v = result.nodes[i];
     stats.largest_move = std::max(stats.largest_move, (moved[i] - mesh.points[v]).norm());

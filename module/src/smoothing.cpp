@@ -98,21 +98,24 @@ void add_power(const Distortion& d, double power, Distortion& sum) {
 // ---------------------------------------------------------------------------------------------------
 // How each node may move.
 
-enum class Freedom : std::uint8_t { fixed, space, box, surface, rim };
+enum class Freedom : std::uint8_t { fixed, space, box, surface, rim, crease };
 
 struct NodeFreedom {
   Freedom kind = Freedom::space;
   std::uint8_t free_axes = 7;  // box: bit i set if coordinate i may change
   std::uint8_t rim_axis = 0;   // rim: the parameter (0 = u, 1 = v) that runs along its side of P
-  int surface = -1;            // surface and rim: which projection, and the node's index in it
+  int surface = -1;            // surface, rim and crease: which projection, and the node's index in it
   int index = -1;
+  const CreaseLine* crease = nullptr;  // crease: the line of P it moves along
 };
 
-// Where a node is: its position and, on a surface, its parameters and the triangle holding them.
+// Where a node is: its position and, on a surface, its parameters and the triangle holding them (and on
+// a crease, its arc length along the line).
 struct Placement {
   Vector3d x;
   Vector2d uv = Vector2d::Zero();
   int triangle = -1;
+  double arc = 0.0;
 };
 
 class Smoother {
@@ -231,6 +234,11 @@ void Smoother::classify_nodes() {
       node.surface = s;
       node.index = i;
       node.kind = Freedom::surface;
+      if (const int line = projection.creases.line_of[i]; line >= 0) {
+        node.kind = Freedom::crease;
+        node.crease = &projection.creases.lines[line];
+        continue;
+      }
       if (!projection.on_rim[i]) continue;
       // Rim parameters lie exactly on the square's sides; a corner of P lies on two and stays fixed.
       const Vector2d& uv = projection.uv[i];
@@ -340,9 +348,10 @@ double Smoother::choose_delta(VertexId v, double& length) const {
 Placement Smoother::placement(VertexId v) const {
   Placement at{mesh_.points[v]};
   const NodeFreedom& node = freedom_[v];
-  if (node.kind == Freedom::surface || node.kind == Freedom::rim) {
+  if (node.surface >= 0) {
     at.uv = surfaces_[node.surface]->uv[node.index];
     at.triangle = surfaces_[node.surface]->surface->locate(at.uv, hints_[node.surface][node.index]).triangle;
+    if (node.kind == Freedom::crease) at.arc = surfaces_[node.surface]->creases.parameter[node.index];
   }
   return at;
 }
@@ -363,6 +372,10 @@ Jacobian Smoother::jacobian(VertexId v, const Placement& at) const {
       break;
     case Freedom::rim:
       j.col(0) = surfaces_[node.surface]->surface->derivative(at.triangle).col(node.rim_axis);
+      break;
+    case Freedom::crease:
+      // φ is continuous across the crease edge and affine along it: either triangle gives this column.
+      j.col(0) = surfaces_[node.surface]->surface->derivative(at.triangle) * node.crease->direction(at.arc);
       break;
     case Freedom::fixed:
       break;
@@ -396,6 +409,12 @@ bool Smoother::move(VertexId v, const Placement& from, const Parameters& step, P
     case Freedom::rim:
       to.uv[node.rim_axis] += step[0];
       if (!(to.uv[node.rim_axis] > 0.0 && to.uv[node.rim_axis] < 1.0)) return false;
+      break;
+    case Freedom::crease:
+      // Strictly inside the line: its ends are where the crease fades or meets another one.
+      to.arc += step[0];
+      if (!(to.arc > 0.0 && to.arc < node.crease->length())) return false;
+      to.uv = node.crease->at(to.arc);
       break;
     case Freedom::fixed:
       return false;
@@ -473,6 +492,7 @@ void Smoother::store(VertexId v, const Placement& at) {
   if (node.surface >= 0) {
     surfaces_[node.surface]->uv[node.index] = at.uv;
     hints_[node.surface][node.index] = at.triangle;
+    if (node.kind == Freedom::crease) surfaces_[node.surface]->creases.parameter[node.index] = at.arc;
   }
 }
 
@@ -510,6 +530,7 @@ SmoothingStats Smoother::run() {
       case Freedom::box: ++stats_.box_nodes; break;
       case Freedom::surface: ++stats_.surface_nodes; break;
       case Freedom::rim: ++stats_.rim_nodes; break;
+      case Freedom::crease: ++stats_.crease_nodes; break;
       case Freedom::fixed: break;
     }
   }

@@ -26,8 +26,13 @@ TetMesh make_cube_meccano(const Box& box, int level = 0);
 // one cell refined j times tells.
 double longest_edge_at_level(const MeccanoGrid& meccano, int level);
 
+// The finest level V_M may be refined to: computational coordinates have grid_bits bits per cell edge
+// (three levels per bit), and V_M's growth may bisect 12 levels beyond its own.
+inline constexpr int finest_level = 3 * grid_bits - 12;
+
 // The coarsest level whose tets all have their longest edge below `resolution` (> 0), so that refining
-// every tet meeting a surface to it satisfies eq. 1 (l_T < l_r) with one level throughout.
+// every tet meeting a surface to it satisfies eq. 1 (l_T < l_r) with one level throughout. InputError
+// if that is finer than finest_level.
 int level_for_resolution(const MeccanoGrid& meccano, double resolution);
 
 }  // namespace meccano

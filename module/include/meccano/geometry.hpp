@@ -57,6 +57,11 @@ double triangle_separation(const Triangle3& a, const Triangle3& b);
 // Euclidean distance between two closed triangles (0 when they intersect).
 double triangle_distance(const Triangle3& a, const Triangle3& b);
 
+// Euclidean distance between two triangulated surfaces (0 when they meet): the smallest triangle_distance
+// over the pairs of `a`'s triangles and `b`'s, found through b's hierarchy (TriangleBVH, below).
+class TriangleBVH;
+double surface_distance(const TriangleSurface& a, const TriangleBVH& b);
+
 // The feature of a triangle that holds a closest point. Edge k joins corners k and (k + 1) % 3.
 enum class Feature { face, edge, vertex };
 

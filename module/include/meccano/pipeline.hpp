@@ -9,10 +9,13 @@
 //             (smoothing.hpp). If tets stay inverted, the insertion is run again with the S_M of the
 //             surfaces next to them on the other side of S (when the side rule allows it); a mesh that
 //             stays tangled is an error, never a result.
-//          A surface whose insertion still fails (V_M cannot be grown within l_r of S, S_M cannot be
+//          A surface whose insertion still fails (V_M cannot be grown within reach of S, S_M cannot be
 //          healed, or the tets next to its S_M stay tangled on both sides) is inserted again, from the
-//          input mesh, at half its l_r, at most options.finer_retries times; l_r is an upper bound on the
-//          edges near S, so a finer one still honours it. result.finer_retries says why.
+//          input mesh, at a finer l_r, at most options.finer_retries times, together with the surfaces
+//          whose S_M could touch its own: half its l_r, or finer where the gap to those surfaces or to
+//          the box leaves no room for S_M at half (the gap decides the first finer l_r, instead of
+//          halving attempt after attempt). l_r is an upper bound on the edges near S, so a finer one
+//          still honours it. result.finer_retries says why.
 //          The surfaces are taken one after the other; a later surface's refinement keeps the earlier
 //          surfaces' regions in step (bisection does not change a region's point set).
 // Output   the refined mesh, each surface's V_M, per-stage statistics and timings; surface_interfaces()
@@ -48,11 +51,12 @@ enum class Stage { volumetric, approximation, projection, smoothing };
 inline constexpr std::int64_t estimated_bytes_per_tet = 280;
 inline constexpr std::int64_t default_max_tets = (std::int64_t{16} << 30) / estimated_bytes_per_tet;
 
-// The tet count after step 1, estimated before any refinement: the meccano's tets plus, per surface,
-// the V_M layer, whose tets have their longest edge below l_r and cover the surface a few tets thick:
-// 185 tets per l_r² of surface area, fitted on the cube example's final counts (73 712, 256 636 and
-// 971 248 tets at l_r = 1/32, 1/64, 1/128, which it matches to -0.3 %, +15 % and +21 %).
-std::int64_t estimate_tets(std::int64_t meccano_tets, std::span<const TriangleSurface> surfaces, double resolution);
+// The tet count of an insertion, estimated before any refinement: the meccano's tets plus, per surface,
+// the cubes of V_M's level (level_for_resolution) that S crosses, from its area and normals, times the
+// tets per such cube of the finished mesh (V_M, the conforming closure around it, healing), fitted per
+// level type on real faults and test surfaces (doc/benchmarks.md, "Predictable cost").
+std::int64_t estimate_tets(const MeccanoGrid& meccano, std::int64_t meccano_tets,
+                           std::span<const TriangleSurface> surfaces, double resolution);
 
 // Throws InputError if `estimated_tets` exceeds `max_tets`, naming `what` (the cause) and the memory it
 // would take.
@@ -62,10 +66,11 @@ struct InsertionOptions {
   double resolution = 0.0;  // l_r, a length in physical units
   Stage last_stage = Stage::smoothing;
   SurfaceApproximationOptions approximation;  // side rule, healing pass limit
+  ProjectionOptions projection;               // Floater weights, creases followed
   SmoothingOptions smoothing;                 // SUS mode, target and limits
   int threads = 0;                            // OpenMP threads for this call; 0 = OpenMP's default
   std::int64_t max_tets = default_max_tets;    // refuse when estimate_tets exceeds it
-  int finer_retries = 2;                      // times a failing surface may be retried at half its l_r
+  int finer_retries = 2;                      // times a failing surface may be retried at a finer l_r
   std::function<void(const std::string&)> progress;  // one line per stage, with counts
 };
 

@@ -6,14 +6,18 @@
 //             way onto S, so that the two parameterizations nearly agree (see projection.cpp). S's corners are chosen along its rim by arc length (natural
 //             corners kept); S_M's are the rim nodes closest to them, in the same cyclic order around the
 //             same mean normal, so φ ∘ φ_M^{-1} does not twist.
-//          2. Each S_M node's own parameters u = φ_M^{-1}(x_M) are located in S's parametric triangulation
-//             and the node moves to φ(u). Rim nodes land on the rim of S, corners on its corners.
+//          2. S_M follows the creases of S sharper than options.crease_angle (creases.hpp): nodes near a
+//             crease move, in P, onto it, forming paths of S_M edges along the crease lines.
+//          3. Each S_M node's parameters u (φ_M^{-1}(x_M), or its place on a crease) are located in S's
+//             parametric triangulation and the node moves to φ(u). Rim nodes land on the rim of S,
+//             corners on its corners, crease nodes on the crease edges of S.
 // Output   the moved mesh (tets may be tangled: step 4 untangles them), the parameterizations, and
 //          statistics: how far nodes moved, how far they are from S afterwards, inverted tets.
 // Errors   MeshingError from the parameterization (rim not one loop, corners impossible, map not
 //          one-to-one).
 #pragma once
 
+#include <meccano/creases.hpp>
 #include <meccano/geometry.hpp>
 #include <meccano/parameterization.hpp>
 #include <meccano/surface.hpp>
@@ -30,6 +34,12 @@ struct ProjectionStats {
   double largest_move = 0.0;           // physical distance, x_i - x_Mi
   double largest_distance_after = 0.0; // of a moved node to S (round-off)
   std::int64_t inverted_tets = 0;      // after the move, before smoothing
+  CreaseStats creases;
+};
+
+struct ProjectionOptions {
+  FloaterWeights weights = FloaterWeights::mean_value;
+  double crease_angle = default_crease_angle;  // degrees; creases of S sharper than this are followed (180: none)
 };
 
 // What step 4 needs to move S_M nodes within S: φ, and each S_M node's parameters.
@@ -40,11 +50,12 @@ struct SurfaceProjection {
   std::vector<std::uint8_t> on_rim;            // same order
   std::vector<std::array<int, 3>> triangles;   // S_M's triangles as indices into `nodes`, oriented like S
   int orientation = 1;                         // the sign of their areas in P (uv), which step 4 keeps
+  CreaseNodes creases;                         // which nodes lie on a crease line of S, and where
   ProjectionStats stats;
 };
 
 SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,
                                        const TriangleSurface& surface, const TriangleBVH& tree,
-                                       FloaterWeights weights = FloaterWeights::mean_value);
+                                       const ProjectionOptions& options = {});
 
 }  // namespace meccano

@@ -23,7 +23,9 @@
 //          triangulation (a short walk from the last triangle); a step that would fold one of S_M's
 //          triangles in P is refused, so S_M stays embedded in S. Rim nodes of S move along their side of
 //          P, that is along the rim of S, and the four corners of P stay fixed: a fixed rim would keep the
-//          chord-length spacing of the projection, which ignores the volume mesh behind it.
+//          chord-length spacing of the projection, which ignores the volume mesh behind it. Nodes on a
+//          crease of S (creases.hpp) move along their crease line of P, strictly inside it: they stay on
+//          the crease edges of S.
 // Sweeps   non-linear Gauss-Seidel. Nodes are coloured so that no two nodes of one colour share a tet;
 //          the nodes of a colour are optimised in parallel, so the result does not depend on the thread
 //          count. A node is skipped when neither it nor any node of its star moved (by more than 1 % of
@@ -83,6 +85,7 @@ struct SmoothingStats {
   std::int64_t box_nodes = 0;       // on a box side or edge
   std::int64_t surface_nodes = 0;   // S_M nodes inside the rim
   std::int64_t rim_nodes = 0;       // S_M rim nodes, corners of P excluded
+  std::int64_t crease_nodes = 0;    // S_M nodes on a crease line of S (projection.hpp)
   std::int64_t active_tets = 0;     // tets with a free node
   int colours = 0;
   std::int64_t inverted_before = 0;

@@ -10,16 +10,29 @@ cube_example.obj   the paper-like patch of the cube example: over (x, y) in [0.2
 spherical_cap.obj  a cap of the sphere of radius 0.4 centred at (0.5, 0.5, 0.2), polar angle up to 65
                    degrees: a circular rim, no natural corners.
 
+With --hard, instead: the hard surfaces of tests/data/hard_surfaces, which reproduce what makes real
+faults hard, in their units (UTM-like metres, x about 5e5, y about 3.8e6, z from -12 km to +1 km),
+each an open disk of at most a few thousand triangles, the same at every run (fixed seeds):
+
+creased.obj        a steep fault folded along three crease lines (10, 25 and 40 degrees), ~1 km triangles
+multiscale.obj     a gently curved fault whose triangles run from a few metres to a few kilometres
+thin_long.obj      a 40 km x 4 km strip (aspect 10:1), curved along strike and twisted
+low_dip.obj        a thrust dipping 5-10 degrees, undulating, 20 km along strike
+vertical.obj       an exactly vertical fault (dip 90 degrees) striking 30 degrees off the x axis, curved
+
 Usage: generate_surfaces.py [--output-dir DIR] [N]   (default N = 48, DIR = the current folder)
+       generate_surfaces.py --hard [--output-dir DIR]   (the committed ones: DIR = tests/data/hard_surfaces)
 """
 import argparse
 import math
 import os
+import random
+import textwrap
 
 
 def write_obj(path, points, triangles, comment):
     with open(path, "w") as out:
-        out.write(f"# {comment}\n")
+        out.writelines(f"# {line}\n" for line in comment.splitlines())
         for p in points:
             out.write("v %.17g %.17g %.17g\n" % p)
         for a, b, c in triangles:
@@ -68,15 +81,257 @@ def spherical_cap(rings):
     return points, triangles
 
 
+# ------------------------------------------------------------------------------------------------
+# Hard surfaces: fault-like disks in UTM-like metres (tests/data/hard_surfaces). Strike directions are
+# angles counterclockwise from the x axis; each surface dips to the left of its strike direction and is
+# triangulated counterclockwise in its (along strike, down dip) parameters.
+
+Z = (0.0, 0.0, 1.0)
+
+
+def add(*vectors):
+    return tuple(sum(components) for components in zip(*vectors))
+
+
+def scaled(v, s):
+    return tuple(s * c for c in v)
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def horizontal(azimuth):
+    """The horizontal unit vector at `azimuth` radians counterclockwise from the x axis."""
+    return (math.cos(azimuth), math.sin(azimuth), 0.0)
+
+
+def down_dip(azimuth, dip):
+    """The unit vector down the dip of a plane striking at `azimuth` and dipping `dip` radians to its left."""
+    return add(scaled(horizontal(azimuth + math.pi / 2), math.cos(dip)), scaled(Z, -math.sin(dip)))
+
+
+def arc_trace(s, length, heading0, heading1):
+    """The point at arc length s of a horizontal circular arc from the origin whose heading turns from
+    heading0 to heading1 (radians) over `length` (a straight line if they are equal)."""
+    if heading0 == heading1:
+        return scaled(horizontal(heading0), s)
+    curvature = (heading1 - heading0) / length
+    heading = heading0 + curvature * s
+    return ((math.sin(heading) - math.sin(heading0)) / curvature, (math.cos(heading0) - math.cos(heading)) / curvature, 0.0)
+
+
+def jittered_grid(columns, rows, seed, jitter=0.3, fixed_columns=(), straight_columns=False):
+    """(u, v) nodes of a columns x rows grid of unit cells, row by row, each moved at random (seeded) by
+    up to `jitter` on each axis: corners stay, rim nodes move along their rim, nodes of `fixed_columns`
+    along v only; with `straight_columns` a column's nodes all move by the same u."""
+    rng = random.Random(seed)
+    fixed = {0, columns, *fixed_columns}
+    shift = [0.0 if i in fixed else rng.uniform(-jitter, jitter) for i in range(columns + 1)]
+    nodes = []
+    for j in range(rows + 1):
+        for i in range(columns + 1):
+            du = shift[i] if straight_columns or i in fixed else rng.uniform(-jitter, jitter)
+            nodes.append((i + du, j + (0.0 if j in (0, rows) else rng.uniform(-jitter, jitter))))
+    return nodes
+
+
+def grid_triangles(points, columns, rows):
+    """Two triangles per cell of a (columns + 1) x (rows + 1) grid of points (row by row), cut along the
+    cell's shorter diagonal, counterclockwise in the grid's (u, v)."""
+    triangles = []
+    for j in range(rows):
+        for i in range(columns):
+            a, b = j * (columns + 1) + i, j * (columns + 1) + i + 1
+            c, d = b + columns + 1, a + columns + 1
+            if math.dist(points[a], points[c]) <= math.dist(points[b], points[d]):
+                triangles += [(a, b, c), (a, c, d)]
+            else:
+                triangles += [(a, b, d), (b, c, d)]
+    return triangles
+
+
+def creased():
+    """20 km along strike, 12 km down a 70 degree dip, folded along three down-dip crease lines 4, 9
+    and 15 km along, where the top trace turns about the down-dip direction by +10, -25 and +40 degrees
+    (the angles between the planes on either side); planar between them; 1 km jittered cells, the
+    creases along cell edges."""
+    columns, rows, cell = 20, 12, 1000.0
+    turns = {4: 10.0, 9: -25.0, 15: 40.0}
+    strike, dip = math.radians(20), math.radians(70)
+    d = down_dip(strike, dip)
+    # The top trace: straight within a panel, turned about d at each crease.
+    starts, point, direction = [], (0.0, 0.0, 0.0), horizontal(strike)
+    for column in range(columns):
+        if column in turns:
+            angle = math.radians(turns[column])
+            direction = add(scaled(direction, math.cos(angle)), scaled(cross(d, direction), math.sin(angle)))
+        starts.append((point, direction))
+        point = add(point, scaled(direction, cell))
+
+    def trace(u):
+        start, direction = starts[min(int(u), columns - 1)]
+        return add(start, scaled(direction, (u - min(int(u), columns - 1)) * cell))
+
+    origin = (512000.0, 3801500.0, 600.0)
+    points = [add(origin, trace(u), scaled(d, v * cell))
+              for u, v in jittered_grid(columns, rows, seed=1, fixed_columns=turns)]
+    return points, grid_triangles(points, columns, rows)
+
+
+def thin_long():
+    """A 40 km x 4 km strip (aspect 10:1): its top trace a horizontal arc whose strike turns from 55 to
+    68 degrees off the x axis, its dip twisting from 62 to 85 degrees along it; 800 m jittered cells."""
+    columns, rows, cell = 50, 5, 800.0
+    length, width = columns * cell, rows * cell
+    heading0, heading1 = math.radians(55), math.radians(68)
+    origin = (498000.0, 3772000.0, 400.0)
+    points = []
+    for u, v in jittered_grid(columns, rows, seed=2):
+        s = u * cell
+        heading = heading0 + (heading1 - heading0) * s / length
+        dip = math.radians(62 + 23 * s / length)
+        points.append(add(origin, arc_trace(s, length, heading0, heading1), scaled(down_dip(heading, dip), v * width / rows)))
+    return points, grid_triangles(points, columns, rows)
+
+
+def low_dip():
+    """A thrust 20 km along a strike 110 degrees off the x axis and 14 km down a 7.5 degree dip,
+    undulating by up to 100 m (wavelengths 5-11 km) so that its dip varies between about 5 and 10
+    degrees (4.3 to 11.8 in single triangles); 1 km jittered cells."""
+    columns, rows, cell = 20, 14, 1000.0
+    strike, dip = math.radians(110), math.radians(7.5)
+    along, across = horizontal(strike), horizontal(strike + math.pi / 2)
+    origin = (541000.0, 3826000.0, -3500.0)
+    points = []
+    for u, v in jittered_grid(columns, rows, seed=3):
+        s, w = u * cell, v * cell
+        z = (-w * math.tan(dip) + 60 * math.sin(2 * math.pi * s / 9000) * math.sin(2 * math.pi * w / 11000)
+             + 40 * math.cos(2 * math.pi * (s - 0.6 * w) / 5000))
+        points.append(add(origin, scaled(along, s), scaled(across, w), scaled(Z, z)))
+    return points, grid_triangles(points, columns, rows)
+
+
+def vertical():
+    """An exactly vertical surface (dip 90 degrees), 20 km along a horizontal arc whose strike turns
+    from 18 to 42 degrees off the x axis (30 on average), from 500 m above to 11.5 km below sea
+    level; 1 km jittered cells whose columns stay vertical lines, so every triangle has a vertical
+    edge and lies in a vertical plane."""
+    columns, rows, cell = 20, 12, 1000.0
+    length = columns * cell
+    origin = (523000.0, 3789000.0, 500.0)
+    points = [add(origin, arc_trace(u * cell, length, math.radians(18), math.radians(42)), (0.0, 0.0, -v * cell))
+              for u, v in jittered_grid(columns, rows, seed=4, straight_columns=True)]
+    return points, grid_triangles(points, columns, rows)
+
+
+def newest_vertex_bisection(points, triangles, too_large):
+    """Refines a conforming triangulation by newest-vertex bisection until no triangle is too_large(its
+    three points). Each triangle (a, b, c) is cut at the midpoint m of its refinement edge a-b into
+    (c, a, m) and (b, c, m), keeping its orientation, together with its neighbour across a-b, which is
+    refined first until a-b is its refinement edge too; every edge of the input must be the refinement
+    edge of both its triangles or of neither (a grid of squares cut along diagonals, the diagonals
+    first, is such). Returns the points (input first) and the triangles."""
+    points, triangles = list(points), [tuple(t) for t in triangles]
+    alive = [True] * len(triangles)
+    owner = {(t[k], t[(k + 1) % 3]): index for index, t in enumerate(triangles) for k in range(3)}
+    midpoints = {}
+
+    def split(index, m):
+        a, b, c = triangles[index]
+        alive[index] = False
+        for k in range(3):
+            del owner[(triangles[index][k], triangles[index][(k + 1) % 3])]
+        for child in ((c, a, m), (b, c, m)):
+            owner.update({(child[k], child[(k + 1) % 3]): len(triangles) for k in range(3)})
+            triangles.append(child)
+            alive.append(True)
+
+    def refine(index):
+        a, b, _ = triangles[index]
+        while (b, a) in owner and triangles[owner[(b, a)]][:2] != (b, a):
+            refine(owner[(b, a)])
+        neighbour = owner.get((b, a))
+        key = (min(a, b), max(a, b))
+        if key not in midpoints:
+            midpoints[key] = len(points)
+            points.append(scaled(add(points[a], points[b]), 0.5))
+        split(index, midpoints[key])
+        if neighbour is not None:
+            split(neighbour, midpoints[key])
+
+    index = 0
+    while index < len(triangles):
+        if alive[index] and too_large([points[v] for v in triangles[index]]):
+            refine(index)
+        index += 1
+    return points, [t for t, kept in zip(triangles, alive) if kept]
+
+
+def multiscale():
+    """A gently curved surface 16 km along strike and 10 km down a dip steepening from 40 to 55 degrees
+    (listric), bowed by 600 m along strike: right isosceles triangles of 2 km legs refined by newest-
+    vertex bisection towards a point, to hypotenuses of 5 m + 0.35 x the distance (triangles from
+    about 4 m to 2.8 km, every angle near 45 or 90 degrees in (s, w)), then the inner nodes jittered by
+    up to a tenth of their shortest edge."""
+    columns, rows, cell = 8, 5, 2000.0
+    length = columns * cell
+    grid = [(i * cell, j * cell) for j in range(rows + 1) for i in range(columns + 1)]
+    triangles = []
+    for j in range(rows):
+        for i in range(columns):
+            a, b = j * (columns + 1) + i, j * (columns + 1) + i + 1
+            c, d = b + columns + 1, a + columns + 1
+            # Refinement edge (the diagonal) first; counterclockwise.
+            triangles += [(a, c, d), (c, a, b)] if (i + j) % 2 == 0 else [(b, d, a), (d, b, c)]
+    focus = (5300.0, 6100.0)
+    parameters, triangles = newest_vertex_bisection(
+        grid, triangles, lambda p: math.dist(p[0], p[1]) > 5 + 0.35 * math.dist(focus, scaled(add(*p), 1 / 3)))
+
+    rng = random.Random(5)
+    shortest = {}
+    for t in triangles:
+        for k in range(3):
+            a, b = t[k], t[(k + 1) % 3]
+            edge = math.dist(parameters[a], parameters[b])
+            shortest[a] = min(shortest.get(a, edge), edge)
+    jittered = [(s, w) if s in (0, length) or w in (0, rows * cell)
+                else (s + rng.uniform(-0.1, 0.1) * shortest[n], w + rng.uniform(-0.1, 0.1) * shortest[n])
+                for n, (s, w) in enumerate(parameters)]
+
+    strike, dip0, dip1 = math.radians(-35), math.radians(40), math.radians(55)
+    along, across = horizontal(strike), horizontal(strike + math.pi / 2)
+    rate = (dip1 - dip0) / (rows * cell)
+    origin = (487000.0, 3794000.0, 0.0)
+
+    def surface_point(s, w):
+        bow = 600 * (1 - (2 * s / length - 1) ** 2)
+        dip = dip0 + rate * w
+        return add(origin, scaled(along, s), scaled(across, bow + (math.sin(dip) - math.sin(dip0)) / rate),
+                   scaled(Z, (math.cos(dip) - math.cos(dip0)) / rate))
+
+    return [surface_point(s, w) for s, w in jittered], triangles
+
+
+HARD_SURFACES = {"creased": creased, "multiscale": multiscale, "thin_long": thin_long, "low_dip": low_dip,
+                 "vertical": vertical}
+
+
 def main():
-    parser = argparse.ArgumentParser(description="Writes cube_example.obj and spherical_cap.obj.")
+    parser = argparse.ArgumentParser(description="Writes cube_example.obj and spherical_cap.obj, or the hard surfaces.")
     parser.add_argument("n", nargs="?", type=int, default=48, help="grid resolution N (the cap gets N // 2 rings)")
+    parser.add_argument("--hard", action="store_true", help="write the hard surfaces of tests/data/hard_surfaces instead")
     parser.add_argument("--output-dir", default=".", help="folder to write into (created if missing)")
     args = parser.parse_args()
     if args.n < 2:
         parser.error(f"N must be at least 2 (got {args.n})")
     os.makedirs(args.output_dir, exist_ok=True)
     n, path = args.n, lambda name: os.path.join(args.output_dir, name)
+    if args.hard:
+        for name, make in HARD_SURFACES.items():
+            write_obj(path(f"{name}.obj"), *make(),
+                      f"{name} (meshes/generate_surfaces.py --hard):\n" + textwrap.fill(" ".join(make.__doc__.split()), 100))
+        return
     write_obj(path("cube_example.obj"), *cube_example(n), f"cube example patch, {n} x {n} grid (generate_surfaces.py)")
     write_obj(path("spherical_cap.obj"), *spherical_cap(n // 2), f"spherical cap, {n // 2} rings (generate_surfaces.py)")
 

@@ -1,0 +1,92 @@
+// The fast subset of the real-surface set (issue 17; the whole set, at four resolutions and against Gmsh,
+// is tests/bench/bench_faults.sh): shared SCEC faults read as they are (GOCAD TSurf, UTM metres) and the
+// synthetic surfaces of tests/data/hard_surfaces that reproduce what makes them hard, each in the box of
+// the benchmarks (its bounding box grown by a tenth of its largest extent E) at l_r = E / divisor.
+//
+// Every result must be a valid mesh (conforming, positively oriented, the box's volume) whose interface
+// lies on S and is oriented like it, reached at the l_r asked without retries, with the tet count within
+// 30 % of estimate_tets and the interface normals within the issue's targets: area-weighted mean <= 1
+// degree. The issue's max <= 15 degrees is not met on every fault (doc/benchmarks.md); here the max is
+// held below the value measured on each case when this test was written, rounded up by a few degrees,
+// so that a change that brings back the chords across creases fails.
+
+#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh_check.hpp>
+#include <meccano/mesh_io.hpp>
+#include <meccano/msh_measure.hpp>
+#include <meccano/pipeline.hpp>
+
+#include <scratch_directory.hpp>
+#include <test_surfaces.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <ostream>
+#include <string>
+
+namespace meccano {
+namespace {
+
+struct RealCase {
+  std::string name;  // test name
+  std::string file;  // a shared fault (file name in ../shared/data/faults) or a path
+  bool shared;       // whether `file` is a shared fault
+  double divisor;    // l_r = E / divisor
+  double max_normal_deviation_deg;
+};
+
+void PrintTo(const RealCase& c, std::ostream* os) { *os << c.name; }
+
+std::string hard_surface(const std::string& name) { return std::string(MECCANO_TEST_DATA_DIR) + "/hard_surfaces/" + name; }
+
+class RealSurface : public testing::ScratchDirectoryTest, public ::testing::WithParamInterface<RealCase> {
+ protected:
+  RealSurface() : ScratchDirectoryTest("meccano-real") {}
+};
+
+TEST_P(RealSurface, IsInsertedValidFaithfulAndAsEstimated) {
+  const RealCase& c = GetParam();
+  const std::string file = c.shared ? testing::shared_fault(c.file) : c.file;
+  if (file.empty()) GTEST_SKIP() << "no shared fault data beside the checkout";
+  TriangleSurface surface = read_surface(file);
+  surface.name = "fault";
+  const double extent = testing::largest_extent(surface);
+  InsertionOptions options;
+  options.resolution = extent / c.divisor;
+  const InsertionResult result =
+      insert_surfaces(make_cube_meccano(testing::box_around(surface), 0), {&surface, 1}, options);
+
+  const MeshCheckReport check = verify_mesh(result.mesh);
+  ASSERT_TRUE(check.ok()) << check.summary();
+  EXPECT_TRUE(result.finer_retries.empty()) << result.finer_retries.front();
+  EXPECT_TRUE(result.side_retry.empty()) << result.side_retry;
+  EXPECT_EQ(result.smoothing.fallback_sweep, 0) << "the meccano target stalled";
+  const double tets = static_cast<double>(result.mesh.num_tets());
+  EXPECT_NEAR(static_cast<double>(result.estimated_tets) / tets, 1.0, 0.3) << result.estimated_tets << " for " << tets;
+
+  const std::string msh = path("fault.msh");
+  write_msh41(result.mesh, output_groups(result), msh);
+  const MeshMeasure measure = measure_mesh_file(msh, {&surface, 1});
+  EXPECT_EQ(measure.inverted, 0);
+  const SurfaceAccuracy& a = *measure.find("interface_fault")->accuracy;
+  EXPECT_LT(a.node_distance_max, 1e-9 * extent) << "an S_M node off S";
+  EXPECT_EQ(a.flipped_faces, 0);
+  EXPECT_LT(a.hausdorff, 0.25 * options.resolution);
+  EXPECT_LE(a.normal_deviation_mean_deg, 1.0);
+  EXPECT_LE(a.normal_deviation_max_deg, c.max_normal_deviation_deg);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    FastSubset, RealSurface,
+    ::testing::Values(RealCase{"East_Huasna_E50", "CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts", true, 50, 20},
+                      RealCase{"Pipes_Canyon_E30", "MJVA-HSLZ-SBMT-Pipes_Canyon_fault_north_extension-CFM5_1000m.ts", true, 30, 36},
+                      RealCase{"creased_E30", hard_surface("creased.obj"), false, 30, 25},
+                      RealCase{"low_dip_E30", hard_surface("low_dip.obj"), false, 30, 6},
+                      RealCase{"thin_long_E30", hard_surface("thin_long.obj"), false, 30, 3},
+                      RealCase{"vertical_E30", hard_surface("vertical.obj"), false, 30, 3}),
+    [](const ::testing::TestParamInfo<RealCase>& info) { return info.param.name; });
+
+}  // namespace
+}  // namespace meccano

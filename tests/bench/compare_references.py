@@ -19,8 +19,9 @@ The driver (bash) runs the tools; this file does everything else, as subcommands
 WORK/manifest.tsv has one line per run: id, section (a b c d), surface, family, parameter (a number:
 l_r, H or the step), label. For run ID, WORK holds ID.json (the tool's own --report), ID.rss (peak
 resident kB from /usr/bin/time -v), ID.measure.json (meccano-immerse measure against the fine surface),
-ID.solver.json (poisson_interface, section c), ID.msh (section d) and moving_base.msh (section d), and
-WORK/options says how the driver was run.
+ID.solver.json (poisson_interface, section c), ID.msh (section d) and moving_base.msh (section d);
+WORK/options says how the driver was run and WORK/finished when the runs ended (date, time and load
+average; machine_line).
 """
 import json
 import math
@@ -465,10 +466,19 @@ def machine_line(work):
         cpu = next((line.split(":", 1)[1].strip() for line in f if line.startswith("model name")), platform.processor())
     with open(os.path.join(work, "options")) as f:
         options = f.read().strip()
-    with open("/proc/loadavg") as f:
-        load = " ".join(f.read().split()[:3])
+    # WORK/finished, if the driver wrote it: "DATE TIME LOAD1 LOAD5 LOAD15" at the end of the runs (UTC),
+    # so that a report re-rendered later still tells when they ran and how busy the machine was.
+    finished = os.path.join(work, "finished")
+    if os.path.exists(finished):
+        with open(finished) as f:
+            day, time, *load = f.read().split()
+        when = f"{day} {time}"
+    else:
+        with open("/proc/loadavg") as f:
+            load = f.read().split()[:3]
+        when = f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M}"
     return (f"Machine: {os.cpu_count()} cores, {cpu}, {platform.system()} {platform.release()}; "
-            f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC; {options}; load average at the end {load} "
+            f"{when} UTC; {options}; load average at the end {' '.join(load)} "
             "(other jobs shared the machine). Times are single runs: compare rows of one run, not runs.")
 
 

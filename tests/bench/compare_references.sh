@@ -217,6 +217,7 @@ for step in 0 1 2 3 4 5; do
     --size-near-surface "$h_s" --size-distance "$("$python" -c "print(4 * $moving_resolution)")"
 done
 
+echo "$(date -u '+%Y-%m-%d %H:%M') $(cut -d ' ' -f 1-3 /proc/loadavg)" > "$work/finished"
 mkdir -p doc/figures
 "$python" "$helper" report "$work" doc/comparison.md doc/figures
 echo "compare_references: wrote doc/comparison.md and doc/figures/comparison_*.png" >&2

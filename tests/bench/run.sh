@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# Builds the project and runs every benchmark, printing their Markdown tables.
-# Usage: tests/bench/run.sh [extra arguments passed to each benchmark]
+# Builds the project and runs every benchmark, printing their Markdown tables: the bench_* programs (given
+# the extra arguments) and a quick run of bench_faults.sh (real faults and hard surfaces, a few minutes).
+# The long runs are separate: tests/bench/bench_faults.sh without --quick (3-4 hours; --write updates
+# doc/benchmarks.md) and tests/bench/compare_references.sh (doc/comparison.md).
+# Usage: tests/bench/run.sh [extra arguments passed to each bench_* program]
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 scripts/build.sh
@@ -12,3 +15,11 @@ for bench in build/tests/bench/bench_*; do
   echo
   "$bench" "$@"
 done
+echo
+echo "## bench_faults.sh --quick"
+echo
+if [ -x build/meshes/reference-gmsh ]; then
+  tests/bench/bench_faults.sh --quick
+else
+  echo "Skipped: build/meshes/reference-gmsh was not built (no Gmsh library found)."
+fi

@@ -139,7 +139,9 @@ TEST(Creases, ARoofKeepsItsRidgeThroughSmoothing) {
         const Eigen::Vector3d& x = result.mesh.points[v];
         from_rim = std::min({from_rim, x.x() - 0.1, 0.9 - x.x(), x.y() - 0.1, 0.9 - x.y()});
       }
-      if (crease_angle < 180) EXPECT_LT(from_rim, 2.0 * options.resolution) << "a face across the ridge inside S";
+      if (crease_angle < 180) {
+        EXPECT_LT(from_rim, 2.0 * options.resolution) << "a face across the ridge inside S";
+      }
     }
     return std::pair{off, projection.creases.stats};
   };

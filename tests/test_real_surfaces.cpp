@@ -86,7 +86,7 @@ INSTANTIATE_TEST_SUITE_P(
                       RealCase{"low_dip_E30", hard_surface("low_dip.obj"), false, 30, 6},
                       RealCase{"thin_long_E30", hard_surface("thin_long.obj"), false, 30, 3},
                       RealCase{"vertical_E30", hard_surface("vertical.obj"), false, 30, 3}),
-    [](const ::testing::TestParamInfo<RealCase>& info) { return info.param.name; });
+    [](const ::testing::TestParamInfo<RealCase>& test) { return test.param.name; });
 
 }  // namespace
 }  // namespace meccano

@@ -170,7 +170,7 @@ class Smoother {
   }
   double star_objective(VertexId v, const Vector3d& x, double delta) const;
   Distortion star_derivatives(VertexId v, const Vector3d& x, double delta) const;
-  double choose_delta(VertexId v, double& length) const;
+  double choose_delta(VertexId v, double& length, bool& tangled_star) const;
 
   Placement placement(VertexId v) const;
   Jacobian jacobian(VertexId v, const Placement& at) const;
@@ -315,13 +315,14 @@ Distortion Smoother::star_derivatives(VertexId v, const Vector3d& x, double delt
   return sum;
 }
 
-// δ from the node's star, and the star's mean edge length at the node, the scale of a sensible step.
+// δ from the node's star, the star's mean edge length at the node (the scale of a sensible step), and
+// whether the star holds an inverted tet.
 // Escobar et al.'s rule δ = √(ε(ε − σ_min)) when σ_min < ε, with the authors' floor 1e-4 · mean|σ| (their
 // code never lets δ reach 0). Their ε (2.2e-10 on a mesh scaled to radius 10) left the cube example
 // with 5 tets inverted after 100 sweeps: each sat in a local minimum behind S. ε = 1e-3 · mean|σ|
 // smooths the objective where the star is tangled and untangled it in 4 sweeps; on valid stars δ is
 // the floor, so the smoothing itself is unchanged.
-double Smoother::choose_delta(VertexId v, double& length) const {
+double Smoother::choose_delta(VertexId v, double& length, bool& tangled_star) const {
   double sigma_min = infinity, sigma_sum = 0.0;
   int local = 0;
   const auto star = stars_.of(v);
@@ -337,6 +338,7 @@ double Smoother::choose_delta(VertexId v, double& length) const {
     ++count;
   });
   length = edges / std::max(count, 1);
+  tangled_star = sigma_min <= 0.0;
   const double scale = sigma_sum / static_cast<double>(std::max<std::size_t>(star.size(), 1));
   // The raised ε is for tangled stars only: on a valid star it would soften the barrier that keeps it
   // valid, and untangling elsewhere would tangle it.
@@ -444,12 +446,15 @@ bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& u
 }
 
 // A few safeguarded Newton steps on the node's star. The new position is kept however small the move.
-// While tangled, any move counts (its neighbours get another look next sweep): untangling creeps. Once
-// smoothing, only a move beyond 1 % of the star's edge length counts, so sweeps stop revisiting regions
-// that have settled.
+// Any move of a node whose star was tangled counts (its neighbours get another look next sweep):
+// untangling creeps. Elsewhere only a move beyond 1 % of the star's edge length counts, so sweeps stop
+// revisiting regions that have settled, also while a few tets elsewhere are still being untangled
+// (revisiting every node then made the last untangling sweeps cost as much as the first: twice the
+// seconds per tet on faults whose last inverted tets took 20 sweeps).
 bool Smoother::optimise(VertexId v) {
   double length = 0.0;
-  const double delta = choose_delta(v, length);
+  bool tangled_star = false;
+  const double delta = choose_delta(v, length, tangled_star);
   const Placement start = placement(v);
   Placement at = start;
   for (int step = 0, steps = tangled_ ? 2 * options_.newton_steps : options_.newton_steps; step < steps; ++step) {
@@ -483,7 +488,7 @@ bool Smoother::optimise(VertexId v) {
   const double moved = (at.x - start.x).norm();
   if (moved == 0.0) return false;
   store(v, at);
-  return tangled_ || moved > 1e-2 * length;
+  return tangled_star || moved > 1e-2 * length;
 }
 
 void Smoother::store(VertexId v, const Placement& at) {
@@ -549,7 +554,8 @@ SmoothingStats Smoother::run() {
   std::int64_t epoch = 0;
   int clean_sweeps = 0;
   std::int64_t fewest_inverted = std::numeric_limits<std::int64_t>::max();
-  int stalled_sweeps = 0;
+  int stalled_sweeps = 0;     // since ε was last raised or the fewest inverted count lowered
+  int sweeps_since_fewest = 0;
   // A new target changes every node's objective: all of them get another look.
   auto switch_target = [&](SmoothingTarget target) {
     aim_at(target);
@@ -563,7 +569,7 @@ SmoothingStats Smoother::run() {
       if (stats_.fallback_sweep == 0) stats_.fallback_sweep = sweep;
       untangling_epsilon_ = initial_untangling_epsilon;
       fewest_inverted = std::numeric_limits<std::int64_t>::max();
-      stalled_sweeps = 0;
+      stalled_sweeps = sweeps_since_fewest = 0;
     }
     const auto start = std::chrono::steady_clock::now();
     std::int64_t optimised = 0;
@@ -598,15 +604,20 @@ SmoothingStats Smoother::run() {
       // (a larger δ where stars are tangled) flattens it so that nodes can pass through.
       if (record.inverted < fewest_inverted) {
         fewest_inverted = record.inverted;
-        stalled_sweeps = 0;
+        stalled_sweeps = sweeps_since_fewest = 0;
       } else if (++stalled_sweeps >= 3 && untangling_epsilon_ < 1.0) {
         untangling_epsilon_ *= 10.0;
         stalled_sweeps = 0;
       }
+      const bool fallback_pending =
+          target_ == SmoothingTarget::meccano && options_.fallback_sweeps > 0 && stats_.fallback_sweep == 0;
+      if (++sweeps_since_fewest > options_.stalled_sweeps && !fallback_pending) break;  // stuck: give up
       continue;
     }
     // A raised ε would keep δ large on valid stars, and their barrier soft: smoothing could tangle again.
     untangling_epsilon_ = initial_untangling_epsilon;
+    // The objective's power changes with the first untangled sweep: every node gets another look.
+    if (clean_sweeps == 0) std::fill(last_optimised.begin(), last_optimised.end(), -1);
     if (clean_sweeps++ == 0 && stats_.inverted_before > 0) stats_.untangling_sweeps = sweep;
     if (clean_sweeps >= options_.smoothing_sweeps || optimised == 0) break;
     if (target_ != options_.target && !returned_from_fallback_) {

@@ -31,7 +31,10 @@
 //          count. A node is skipped when neither it nor any node of its star moved (by more than 1 % of
 //          its star's edge length) since it was last optimised. The sweeps stop after `smoothing_sweeps`
 //          sweeps that end with no inverted tet (the authors' rule), or earlier once such a sweep lowers
-//          the objective by less than `tolerance` (relative), or after `max_sweeps` sweeps.
+//          the objective by less than `tolerance` (relative), or after `max_sweeps` sweeps. Untangling
+//          gives up earlier, once `stalled_sweeps` sweeps in a row have not lowered the fewest inverted
+//          tets so far and no fallback is left to try: a stuck attempt then costs about 40 sweeps, not
+//          100, before the caller tries the other side or a finer l_r.
 // Fallback If tets are still inverted after `fallback_sweeps` sweeps towards the meccano target, the
 //          untangling goes on towards the equilateral target, and the smoothing sweeps that follow the
 //          untangling aim at the meccano target again. Some projected S_M leave stars whose meccano shapes
@@ -64,6 +67,7 @@ struct SmoothingOptions {
   int max_sweeps = 100;
   int fallback_sweeps = 20;  // tangled sweeps towards the meccano target before the equilateral fallback; 0: never
   int smoothing_sweeps = 20;
+  int stalled_sweeps = 20;   // tangled sweeps without a new fewest-inverted count before giving up (fallback done)
   double tolerance = 1e-3;
   double power = 4.0;    // p of Σ η*^p once untangled; 1 is the paper's objective
   int newton_steps = 2;  // per node and sweep

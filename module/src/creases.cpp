@@ -13,21 +13,12 @@ namespace meccano {
 namespace {
 
 using detail::Edge;
+using detail::edges_with_triangles;
 using detail::make_edge;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
 double cross2(const Vector2d& a, const Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-// Every edge of a triangle set with the triangles on it, sorted by edge.
-std::vector<std::pair<Edge, int>> edges_with_triangles(std::span<const std::array<int, 3>> triangles) {
-  std::vector<std::pair<Edge, int>> edges;
-  edges.reserve(3 * triangles.size());
-  for (int t = 0; t < static_cast<int>(triangles.size()); ++t)
-    for (int k = 0; k < 3; ++k) edges.push_back({make_edge(triangles[t][k], triangles[t][(k + 1) % 3]), t});
-  std::ranges::sort(edges);
-  return edges;
-}
 
 // The crease edges of S (with their angles) and the vertices on its rim.
 struct CreaseGraph {

@@ -4,6 +4,8 @@
 #include <meccano/error.hpp>
 #include <meccano/mesh_check.hpp>
 
+#include "topology_helpers.hpp"
+
 #include <omp.h>
 
 #include <Eigen/Geometry>
@@ -266,19 +268,12 @@ namespace {
 
 // The length of a surface's rim: its edges used by one triangle.
 double rim_length(const TriangleSurface& surface) {
-  std::vector<std::array<int, 2>> edges;
-  edges.reserve(3 * surface.triangles.size());
-  for (const auto& triangle : surface.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const auto [low, high] = std::minmax(triangle[k], triangle[(k + 1) % 3]);
-      edges.push_back({low, high});
-    }
-  std::ranges::sort(edges);
+  const auto edges = detail::edges_with_triangles(surface.triangles);
   double length = 0.0;
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if (j - i == 1) length += (surface.points[edges[i][1]] - surface.points[edges[i][0]]).norm();
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    if (j - i == 1) length += (surface.points[edges[i].first.second] - surface.points[edges[i].first.first]).norm();
     i = j;
   }
   return length;
@@ -381,7 +376,7 @@ double finer_resolution(const MeccanoGrid& meccano, const Clearances& clearance,
   return finer;
 }
 
-// The insertion at l_r, and where it fails, again with the failing surfaces at half their l_r.
+// The insertion at l_r, and where it fails, again with the failing surfaces at a finer l_r.
 InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();
   std::int64_t estimated_tets = mesh.num_tets();

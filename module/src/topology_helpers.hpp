@@ -1,5 +1,6 @@
 // Small helpers shared by the stages that reason about the topology of regions and surfaces of the
-// mesh (volumetric_approximation.cpp, surface_approximation.cpp). Internal: not installed.
+// mesh and of S (volumetric_approximation.cpp, surface_approximation.cpp, creases.cpp, pipeline.cpp).
+// Internal: not installed.
 #pragma once
 
 #include <meccano/tet_mesh.hpp>
@@ -15,6 +16,17 @@ namespace meccano::detail {
 
 using Edge = std::pair<VertexId, VertexId>;
 inline Edge make_edge(VertexId a, VertexId b) { return a < b ? Edge{a, b} : Edge{b, a}; }
+
+// Every edge of a set of triangles with a triangle holding it, sorted by edge: an edge of one triangle (on
+// the rim) comes once, an edge shared by two triangles twice, in consecutive entries.
+inline std::vector<std::pair<Edge, int>> edges_with_triangles(std::span<const std::array<VertexId, 3>> triangles) {
+  std::vector<std::pair<Edge, int>> edges;
+  edges.reserve(3 * triangles.size());
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t)
+    for (int k = 0; k < 3; ++k) edges.push_back({make_edge(triangles[t][k], triangles[t][(k + 1) % 3]), t});
+  std::sort(edges.begin(), edges.end());
+  return edges;
+}
 
 class UnionFind {
  public:

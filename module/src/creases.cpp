@@ -247,19 +247,22 @@ void snap_path(int l, std::vector<PathNode>& path, std::span<const std::array<in
 
 }  // namespace
 
+std::size_t CreaseLine::segment(double s) const {
+  const auto end = std::min<std::size_t>(std::ranges::upper_bound(arc, std::clamp(s, 0.0, length())) - arc.begin(),
+                                         arc.size() - 1);
+  return end == 0 ? 0 : end - 1;
+}
+
 Vector2d CreaseLine::at(double s) const {
   s = std::clamp(s, 0.0, length());
-  const auto segment = std::min<std::size_t>(std::ranges::upper_bound(arc, s) - arc.begin(), arc.size() - 1);
-  const std::size_t i = segment == 0 ? 0 : segment - 1;
+  const std::size_t i = segment(s);
   const double span = arc[i + 1] - arc[i];
   const double t = span > 0.0 ? (s - arc[i]) / span : 0.0;
   return uv[i] + t * (uv[i + 1] - uv[i]);
 }
 
 Vector2d CreaseLine::direction(double s) const {
-  s = std::clamp(s, 0.0, length());
-  const auto segment = std::min<std::size_t>(std::ranges::upper_bound(arc, s) - arc.begin(), arc.size() - 1);
-  const std::size_t i = segment == 0 ? 0 : segment - 1;
+  const std::size_t i = segment(s);
   return (uv[i + 1] - uv[i]).normalized();
 }
 

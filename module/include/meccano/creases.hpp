@@ -33,6 +33,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -54,6 +55,7 @@ struct CreaseLine {
   double length() const { return arc.back(); }
   Eigen::Vector2d at(double s) const;         // the point at arc length s, clamped to [0, length]
   Eigen::Vector2d direction(double s) const;  // unit tangent of the segment holding s
+  std::size_t segment(double s) const;        // the segment holding s (clamped to the line): uv[i] to uv[i + 1]
 };
 
 // The crease polylines of S. `uv` holds S's vertices' parameters; `angle` in degrees (> 0).

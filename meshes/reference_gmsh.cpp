@@ -233,9 +233,11 @@ void set_size_field(const std::vector<meccano::TriangleSurface>& surfaces, const
   });
 }
 
-void add_named_group(int dim, const std::vector<int>& entities, const std::string& name) {
-  const int group = gmsh::model::addPhysicalGroup(dim, entities);
-  gmsh::model::setPhysicalName(dim, group, name);
+// With its tag given: left to itself, Gmsh numbers physical groups across dimensions (domain 1, the
+// sides 2-7), not as meccano-immerse does.
+void add_named_group(int dim, const std::vector<int>& entities, int tag, const std::string& name) {
+  gmsh::model::addPhysicalGroup(dim, entities, tag);
+  gmsh::model::setPhysicalName(dim, tag, name);
 }
 
 // Counts and quality of the tets Gmsh made, measured like every reference's (reference_common.hpp).
@@ -333,11 +335,13 @@ int run(const Options& options) {
   gmsh::model::mesh::embed(2, surface_entities, 3, box.volume);
   if (options.size_field) set_size_field(surfaces, *options.size_field, *common.size);
 
-  add_named_group(3, {box.volume}, "domain");
-  for (int side = 0; side < 6; ++side)
-    add_named_group(2, {box.sides[side]}, meccano::box_side_name(static_cast<meccano::BoxSide>(side)));
+  add_named_group(3, {box.volume}, meccano::domain_tag, "domain");
+  for (int side = 0; side < 6; ++side) {
+    const auto box_side = static_cast<meccano::BoxSide>(side);
+    add_named_group(2, {box.sides[side]}, meccano::box_side_tag(box_side), meccano::box_side_name(box_side));
+  }
   for (std::size_t s = 0; s < surfaces.size(); ++s)
-    add_named_group(2, {surface_entities[s]}, "interface_" + surfaces[s].name);
+    add_named_group(2, {surface_entities[s]}, meccano::interface_tag(static_cast<int>(s)), "interface_" + surfaces[s].name);
 
   if (options.size_field)
     progress.say("gmsh: size field: ", options.size_field->near_surface, " at the surfaces, growing to ", *common.size,

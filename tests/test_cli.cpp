@@ -39,11 +39,7 @@ class CliTest : public testing::ScratchDirectoryTest {
   CliTest() : ScratchDirectoryTest("meccano-cli") {}
 
   std::string write_obj(const std::string& name, const TriangleSurface& surface) const {
-    std::ofstream out(path(name));
-    out.precision(17);
-    for (const auto& p : surface.points) out << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-    for (const auto& t : surface.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
-    return path(name);
+    return testing::write_obj(path(name), surface);
   }
 
   // The surfaces as one GOCAD TSurf object, a TFACE each, followed by `extra` lines. No coordinate

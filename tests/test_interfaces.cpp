@@ -105,6 +105,39 @@ TEST(SurfaceInterfaces, TheNegativeSideRuleBuildsSMBelowSAndKeepsTheNormalsOfS) 
   expect_consistent(result, interfaces[0], surfaces[0]);
 }
 
+// A solver builds cell t from oriented_tet(t), as the guide says, and numbers its faces by the vertex
+// each is opposite. oriented_local_face must then name the cell's face that every reference means: the
+// same three nodes, and for the interface the cell the normal points out of (negative) or into.
+TEST(SurfaceInterfaces, EveryFaceReferenceNamesTheFaceOfTheOrientedCell) {
+  const std::vector<TriangleSurface> surfaces{testing::paper_like_patch(16)};
+  const InsertionResult result = insert(surfaces, coarse());
+  const TetMesh& mesh = result.mesh;
+  const auto cell_face = [&](FaceRef ref) {
+    const auto cell = mesh.oriented_tet(ref.tet);
+    const int k = mesh.oriented_local_face(ref.tet, ref.local_face);
+    return std::pair{sorted({cell[(k + 1) % 4], cell[(k + 2) % 4], cell[(k + 3) % 4]}), mesh.points[cell[k]]};
+  };
+  std::int64_t references = 0, swapped = 0;
+  for (const FaceGroup& group : output_groups(result).surfaces)
+    for (const FaceRef ref : group.faces) {
+      EXPECT_EQ(cell_face(ref).first, sorted(mesh.outward_face(ref.tet, ref.local_face))) << group.name;
+      ++references;
+      swapped += mesh.oriented_local_face(ref.tet, ref.local_face) != ref.local_face;
+    }
+  const auto interfaces = surface_interfaces(result);
+  for (const InterfaceFace& face : interfaces.at(0).faces) {
+    const Vector3d& a = mesh.points[face.vertices[0]];
+    for (const auto& [side, sign] : {std::pair{face.negative, -1.0}, std::pair{face.positive, 1.0}}) {
+      const auto [nodes, apex] = cell_face(side);
+      EXPECT_EQ(nodes, sorted(face.vertices));
+      EXPECT_GT(sign * (apex - a).dot(face.normal), 0.0) << "the cell's apex lies on the wrong side of the face";
+      ++references;
+    }
+  }
+  // Not a vacuous check: in the meccano, about half the tets are negatively ordered.
+  EXPECT_GT(swapped, references / 10);
+}
+
 TEST(SurfaceInterfaces, NoneBeforeTheApproximationStage) {
   const std::vector<TriangleSurface> surfaces{testing::paper_like_patch(16)};
   InsertionOptions options = coarse();

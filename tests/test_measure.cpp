@@ -35,13 +35,6 @@ std::string file_text(const std::string& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-void write_obj(const std::string& path, const TriangleSurface& surface) {
-  std::ofstream out(path);
-  out.precision(17);
-  for (const auto& p : surface.points) out << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-  for (const auto& t : surface.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
-}
-
 // The square [lo, hi]^2 at height z as two triangles, normal towards +z.
 TriangleSurface square(double lo, double hi, double z, const std::string& name) {
   TriangleSurface s;
@@ -127,7 +120,7 @@ class SquarePatch : public testing::ScratchDirectoryTest {
   std::string write_square_mesh(const std::string& name, bool upward, bool hole = false) const {
     const TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, {4, 4, 4}, 3);
     MeshGroups groups = standard_groups(mesh);
-    FaceGroup& patch = groups.surfaces.emplace_back(FaceGroup{"interface_square", {}});
+    FaceGroup& patch = groups.surfaces.emplace_back(FaceGroup{"interface_square", interface_tag(0), {}});
     for (TetId t = 0; t < mesh.num_tets(); ++t)
       for (int f = 0; f < 4; ++f) {
         bool on_square = true, in_hole = hole;
@@ -236,7 +229,7 @@ using testing::run_command;
 TEST_F(SquarePatch, CommandWritesTheLibrarysReport) {
   const std::string mesh = write_square_mesh("up.msh", true);
   TriangleSurface shifted = square(0.25, 0.75, 0.51, "square");
-  write_obj(path("square.obj"), shifted);
+  testing::write_obj(path("square.obj"), shifted);
   const std::string measure = std::string(MECCANO_CLI) + " measure " + mesh;
   const auto run = run_command(measure + " --surface " + path("square.obj") + ":square --report " + path("m.json"));
   ASSERT_EQ(run.status, 0) << run.output;
@@ -254,7 +247,7 @@ TEST_F(SquarePatch, CommandWritesTheLibrarysReport) {
 
 TEST_F(SquarePatch, CommandErrorsNameTheFiles) {
   const std::string mesh = write_square_mesh("up.msh", true);
-  write_obj(path("square.obj"), square(0.25, 0.75, 0.51, "square"));
+  testing::write_obj(path("square.obj"), square(0.25, 0.75, 0.51, "square"));
   const std::string measure = std::string(MECCANO_CLI) + " measure ";
   // Without :NAME the surface is named by its position, as in the meshing command.
   const auto unnamed = run_command(measure + mesh + " --surface " + path("square.obj") + " --report " + path("x.json"));

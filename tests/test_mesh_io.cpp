@@ -126,8 +126,8 @@ ReadBack read_with_gmsh(const fs::path& path, bool by_entity = false) {
   return result;
 }
 
-TetGroup every_nth_tet(const TetMesh& mesh, const std::string& name, int n) {
-  TetGroup group{name, {}};
+TetGroup every_nth_tet(const TetMesh& mesh, const std::string& name, int tag, int n) {
+  TetGroup group{name, tag, {}};
   for (TetId t = 0; t < mesh.num_tets(); t += n) group.tets.push_back(t);
   return group;
 }
@@ -182,9 +182,9 @@ TEST_P(MshVersions, ReadBackByGmshWithGroupsCountsAndOutwardNormals) {
 TEST_P(MshVersions, OverlappingGroupsReadBackWithTheirOwnElements) {
   const TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 3);
   MeshGroups groups = standard_groups(mesh);
-  const TetGroup half = every_nth_tet(mesh, "volumetric_1", 2);
+  const TetGroup half = every_nth_tet(mesh, "volumetric_1", 2, 2);
   groups.volumes.push_back(half);
-  FaceGroup corner{"corner", {groups.surfaces[0].faces[0]}};
+  FaceGroup corner{"corner", 7, {groups.surfaces[0].faces[0]}};
   groups.surfaces.push_back(corner);
   const fs::path path = write(mesh, groups, "groups.msh");
   const ReadBack back = read_with_gmsh(path);
@@ -204,9 +204,9 @@ INSTANTIATE_TEST_SUITE_P(MeshIo, MshVersions, ::testing::Values(MshVersion::v41,
 TEST(MeshIo, MeditIsReadBackByGmshWithAReferencePerGroup) {
   const TetMesh mesh = make_cube_meccano({{0, 0, 0}, {2, 1, 1}}, 3);
   MeshGroups groups = standard_groups(mesh);
-  const TetGroup inner = every_nth_tet(mesh, "inner", 3);
-  groups.volumes.insert(groups.volumes.begin(), inner);  // ref 1; the other tets keep domain's, 2
-  FaceGroup corner{"corner", {groups.surfaces[0].faces[0], groups.surfaces[0].faces[1]}};
+  const TetGroup inner = every_nth_tet(mesh, "inner", 2, 3);
+  groups.volumes.insert(groups.volumes.begin(), inner);  // ref 2; the other tets keep domain's, 1
+  FaceGroup corner{"corner", 7, {groups.surfaces[0].faces[0], groups.surfaces[0].faces[1]}};
   groups.surfaces.push_back(corner);  // ref 7, faces also in xmin
   const fs::path path = temporary_directory() / "bar.mesh";
   write_medit(mesh, groups, path.string());
@@ -215,8 +215,8 @@ TEST(MeshIo, MeditIsReadBackByGmshWithAReferencePerGroup) {
   EXPECT_EQ(back.nodes, static_cast<std::size_t>(mesh.num_vertices()));
   EXPECT_EQ(back.tets, static_cast<std::size_t>(mesh.num_tets()));
   EXPECT_EQ(back.triangles, boundary_face_count(mesh) + 2);
-  EXPECT_EQ(back.elements_per_group.at("3/1"), inner.tets.size());
-  EXPECT_EQ(back.elements_per_group.at("3/2"), mesh.num_tets() - inner.tets.size());
+  EXPECT_EQ(back.elements_per_group.at("3/2"), inner.tets.size());
+  EXPECT_EQ(back.elements_per_group.at("3/1"), mesh.num_tets() - inner.tets.size());
   EXPECT_EQ(back.negative_tets, 0);
   EXPECT_NEAR(back.tet_volume.at("3/1") + back.tet_volume.at("3/2"), 2.0, 1e-12);
   for (int side = 0; side < 6; ++side) {  // xmin .. zmax are refs 1 .. 6
@@ -227,7 +227,7 @@ TEST(MeshIo, MeditIsReadBackByGmshWithAReferencePerGroup) {
 
   const std::string text = file_text(path);
   EXPECT_EQ(text.rfind("MeshVersionFormatted 2\nDimension 3\n", 0), 0u);
-  for (const char* line : {"\n# Tetrahedra ref 1 inner\n", "\n# Tetrahedra ref 2 domain\n",
+  for (const char* line : {"\n# Tetrahedra ref 2 inner\n", "\n# Tetrahedra ref 1 domain\n",
                            "\n# Triangles ref 1 xmin\n", "\n# Triangles ref 6 zmax\n", "\n# Triangles ref 7 corner\n"})
     EXPECT_NE(text.find(line), std::string::npos) << line;
   fs::remove_all(path.parent_path());
@@ -254,21 +254,22 @@ TEST(MeshIo, VtuIsReadBackWithCellsGroupsAndQualities) {
   for (const auto& tet : mesh.tets) tets_around_moved += std::find(tet.begin(), tet.end(), moved) != tet.end();
 
   MeshGroups groups = standard_groups(mesh);
-  const TetGroup half = every_nth_tet(mesh, "volumetric_1", 2);
+  const TetGroup half = every_nth_tet(mesh, "volumetric_1", 2, 2);
   groups.volumes.push_back(half);
   const fs::path path = temporary_directory() / "bar.vtu";
   write_vtu(mesh, groups, path.string());
   const testing::VtuFile vtu = testing::read_vtu(path.string());
 
-  // Tags: 3D groups first, then 2D groups, named in the field data.
-  std::map<int, std::size_t> expected_cells_of_tag{{1, mesh.tets.size()}, {2, half.tets.size()}};
-  std::map<std::string, int> tag_of{{"domain", 1}, {"volumetric_1", 2}};
-  for (std::size_t g = 0; g < groups.surfaces.size(); ++g) {
-    expected_cells_of_tag[static_cast<int>(g) + 3] = groups.surfaces[g].faces.size();
-    tag_of[groups.surfaces[g].name] = static_cast<int>(g) + 3;
+  // Tags per dimension, as in MSH (domain 1, volumetric_1 2; xmin .. zmax 1 .. 6), named in the field
+  // data as (tag, dimension); the cell type tells the dimension.
+  std::map<std::pair<int, int>, std::size_t> expected_cells_of_group{{{3, 1}, mesh.tets.size()},
+                                                                     {{3, 2}, half.tets.size()}};
+  std::map<std::string, std::vector<double>> field{{"domain", {1, 3}}, {"volumetric_1", {2, 3}}};
+  for (const FaceGroup& side : groups.surfaces) {
+    expected_cells_of_group[{2, side.tag}] = side.faces.size();
+    field[side.name] = {double(side.tag), 2};
   }
-  ASSERT_EQ(vtu.field.size(), tag_of.size());
-  for (const auto& [name, tag] : tag_of) EXPECT_EQ(vtu.field.at(name), std::vector<double>{double(tag)}) << name;
+  EXPECT_EQ(vtu.field, field);
   const std::size_t cells = mesh.tets.size() + half.tets.size() + boundary_face_count(mesh);
   ASSERT_EQ(vtu.points, mesh.num_vertices());
   ASSERT_EQ(vtu.cells, static_cast<std::int64_t>(cells));
@@ -288,7 +289,7 @@ TEST(MeshIo, VtuIsReadBackWithCellsGroupsAndQualities) {
     const auto i = static_cast<std::size_t>(node);
     return Eigen::Vector3d(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
   };
-  std::map<int, std::size_t> cells_of_tag;
+  std::map<std::pair<int, int>, std::size_t> cells_of_group;  // (dimension, tag)
   std::map<int, Eigen::Vector3d> normal_sum;
   double domain_volume = 0;
   std::size_t lowered = 0;
@@ -296,7 +297,7 @@ TEST(MeshIo, VtuIsReadBackWithCellsGroupsAndQualities) {
     const auto begin = static_cast<std::size_t>(c == 0 ? 0 : offsets[c - 1]);
     const auto size = static_cast<std::size_t>(offsets[c]) - begin;
     const int tag = static_cast<int>(group[c]);
-    ++cells_of_tag[tag];
+    ++cells_of_group[{types[c] == 10 ? 3 : 2, tag}];
     if (types[c] == 10) {
       ASSERT_EQ(size, 4u);
       const std::array<Eigen::Vector3d, 4> p{point(connectivity[begin]), point(connectivity[begin + 1]),
@@ -319,11 +320,11 @@ TEST(MeshIo, VtuIsReadBackWithCellsGroupsAndQualities) {
       EXPECT_EQ(equilateral_quality[c], 1.0);
     }
   }
-  EXPECT_EQ(cells_of_tag, expected_cells_of_tag);
+  EXPECT_EQ(cells_of_group, expected_cells_of_group);
   EXPECT_NEAR(domain_volume, 2.0, 1e-12);
   EXPECT_EQ(lowered, tets_around_moved);
   for (const auto& [name, normal] : bar_side_normals)
-    EXPECT_LT((normal_sum[tag_of.at(name)] - normal).norm(), 1e-12) << name;
+    EXPECT_LT((normal_sum[static_cast<int>(field.at(name)[0])] - normal).norm(), 1e-12) << name;
   fs::remove_all(path.parent_path());
 }
 
@@ -353,16 +354,22 @@ const std::map<std::string, std::function<void(const TetMesh&, const MeshGroups&
 TEST(MeshIo, InvalidGroupsAreRejectedBeforeAnythingIsWritten) {
   const TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
   MeshGroups missing_tet = standard_groups(mesh);
-  missing_tet.volumes.push_back({"stray", {mesh.num_tets()}});
+  missing_tet.volumes.push_back({"stray", 2, {mesh.num_tets()}});
   MeshGroups missing_face = standard_groups(mesh);
-  missing_face.surfaces.push_back({"bad_face", {{0, 4}}});
+  missing_face.surfaces.push_back({"bad_face", 7, {{0, 4}}});
   MeshGroups quoted = standard_groups(mesh);
   quoted.surfaces[0].name = "x\"min";
+  MeshGroups repeated_tag = standard_groups(mesh);
+  repeated_tag.surfaces.push_back({"interface_again", 6, {{0, 0}}});
+  MeshGroups zero_tag = standard_groups(mesh);
+  zero_tag.volumes[0].tag = 0;
   const fs::path dir = temporary_directory();
   for (const auto& [format, write] : writers)
     for (const auto& [groups, message] : {std::pair{missing_tet, "mesh group stray: tet 6 does not exist"},
                                           std::pair{missing_face, "mesh group bad_face: tet 0 has no local face 4"},
-                                          std::pair{quoted, "names may not hold"}}) {
+                                          std::pair{quoted, "names may not hold"},
+                                          std::pair{repeated_tag, "interface_again: tag 6 is already the tag of another 2D"},
+                                          std::pair{zero_tag, "mesh group domain: tag 0 is not positive"}}) {
       try {
         write(mesh, groups, (dir / "out").string());
         ADD_FAILURE() << format << ": no error for " << message;

@@ -129,12 +129,7 @@ class ReferenceGmshCliTest : public testing::ScratchDirectoryTest {
 
   // The surface as the OBJ file `name`.obj in the directory; returns its path.
   std::string write_obj(const TriangleSurface& surface, const std::string& name) const {
-    const std::string file = path(name + ".obj");
-    std::ofstream out(file);
-    out.precision(17);
-    for (const auto& p : surface.points) out << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-    for (const auto& t : surface.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
-    return file;
+    return testing::write_obj(path(name + ".obj"), surface);
   }
 };
 

@@ -128,13 +128,7 @@ class ReferenceTetgenCliTest : public testing::ScratchDirectoryTest {
   // The surfaces as OBJ files in the directory; returns their paths.
   std::vector<std::string> write_objs(const std::vector<TriangleSurface>& surfaces) const {
     std::vector<std::string> files;
-    for (const auto& surface : surfaces) {
-      files.push_back(path(surface.name + ".obj"));
-      std::ofstream out(files.back());
-      out.precision(17);
-      for (const auto& p : surface.points) out << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-      for (const auto& t : surface.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
-    }
+    for (const auto& surface : surfaces) files.push_back(testing::write_obj(path(surface.name + ".obj"), surface));
     return files;
   }
 

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
@@ -25,6 +26,18 @@ void check_groups(const TetMesh& mesh, const MeshGroups& groups) {
       throw std::invalid_argument("mesh group " + name + ": tet " + std::to_string(t) + " does not exist (" +
                                   std::to_string(mesh.num_tets()) + " tets)");
   };
+  auto check_tags = [](const auto& same_dimension, const char* dimension) {
+    std::set<int> tags;
+    for (const auto& group : same_dimension) {
+      if (group.tag < 1)
+        throw std::invalid_argument("mesh group " + group.name + ": tag " + std::to_string(group.tag) + " is not positive");
+      if (!tags.insert(group.tag).second)
+        throw std::invalid_argument("mesh group " + group.name + ": tag " + std::to_string(group.tag) +
+                                    " is already the tag of another " + dimension + " group");
+    }
+  };
+  check_tags(groups.volumes, "3D");
+  check_tags(groups.surfaces, "2D");
   for (const TetGroup& group : groups.volumes) {
     check_name(group.name);
     for (const TetId t : group.tets) check_tet(group.name, t);
@@ -56,13 +69,16 @@ std::int64_t group_triangle_count(const MeshGroups& groups) {
 
 MeshGroups standard_groups(const TetMesh& mesh, const std::vector<std::string>& interface_names) {
   MeshGroups groups;
-  TetGroup domain{"domain", {}};
+  TetGroup domain{"domain", domain_tag, {}};
   domain.tets.resize(mesh.tets.size());
   for (TetId t = 0; t < mesh.num_tets(); ++t) domain.tets[t] = t;
   groups.volumes.push_back(std::move(domain));
 
   std::vector<FaceGroup> sides(6);
-  for (int s = 0; s < 6; ++s) sides[s].name = box_side_name(static_cast<BoxSide>(s));
+  for (int s = 0; s < 6; ++s) {
+    sides[s].name = box_side_name(static_cast<BoxSide>(s));
+    sides[s].tag = box_side_tag(static_cast<BoxSide>(s));
+  }
   std::map<int, FaceGroup> interfaces;
   for (TetId t = 0; t < mesh.num_tets(); ++t)
     for (int f = 0; f < 4; ++f) {
@@ -77,6 +93,7 @@ MeshGroups standard_groups(const TetMesh& mesh, const std::vector<std::string>& 
         group.name = "interface_" + (index < static_cast<int>(interface_names.size())
                                          ? interface_names[index]
                                          : std::to_string(index + 1));
+        group.tag = tag;
         group.faces.push_back({t, f});
       }
     }

@@ -64,19 +64,18 @@ void check_groups(const TetMesh& mesh, const MeshGroups& groups);
 std::int64_t group_tet_count(const MeshGroups& groups);
 std::int64_t group_triangle_count(const MeshGroups& groups);
 
-// visit(group index, tet, positively oriented vertices) for every tet of every 3D group, group by group.
+// visit(group tag, tet, positively oriented vertices) for every tet of every 3D group, group by group.
 template <class Visit>
 void for_each_group_tet(const TetMesh& mesh, const MeshGroups& groups, Visit&& visit) {
-  for (std::size_t g = 0; g < groups.volumes.size(); ++g)
-    for (const TetId t : groups.volumes[g].tets) visit(static_cast<int>(g), t, mesh.oriented_tet(t));
+  for (const TetGroup& group : groups.volumes)
+    for (const TetId t : group.tets) visit(group.tag, t, mesh.oriented_tet(t));
 }
 
-// visit(group index, vertices oriented out of the face's tet) for every face of every 2D group.
+// visit(group tag, vertices oriented out of the face's tet) for every face of every 2D group.
 template <class Visit>
 void for_each_group_triangle(const TetMesh& mesh, const MeshGroups& groups, Visit&& visit) {
-  for (std::size_t g = 0; g < groups.surfaces.size(); ++g)
-    for (const FaceRef& face : groups.surfaces[g].faces)
-      visit(static_cast<int>(g), mesh.outward_face(face.tet, face.local_face));
+  for (const FaceGroup& group : groups.surfaces)
+    for (const FaceRef& face : group.faces) visit(group.tag, mesh.outward_face(face.tet, face.local_face));
 }
 
 }  // namespace meccano::mesh_io

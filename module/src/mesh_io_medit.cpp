@@ -11,8 +11,8 @@ void write_medit(const TetMesh& mesh, const MeshGroups& groups, const std::strin
   mesh_io::check_groups(mesh, groups);
   // A tet's reference is its first 3D group; 0 = in none, not written.
   std::vector<int> reference(mesh.tets.size(), 0);
-  for (std::size_t g = groups.volumes.size(); g-- > 0;)
-    for (const TetId t : groups.volumes[g].tets) reference[t] = static_cast<int>(g + 1);
+  for (auto group = groups.volumes.rbegin(); group != groups.volumes.rend(); ++group)
+    for (const TetId t : group->tets) reference[t] = group->tag;
   std::int64_t tets = 0;
   for (const int ref : reference) tets += ref != 0;
 
@@ -20,10 +20,10 @@ void write_medit(const TetMesh& mesh, const MeshGroups& groups, const std::strin
     mesh_io::TextWriter out(stream);
     // Readers take the first line for the version, so the comments come after the header.
     out << "MeshVersionFormatted 2\nDimension 3\n";
-    for (std::size_t g = 0; g < groups.volumes.size(); ++g)
-      out << "# Tetrahedra ref " << static_cast<int>(g + 1) << ' ' << std::string_view(groups.volumes[g].name) << '\n';
-    for (std::size_t g = 0; g < groups.surfaces.size(); ++g)
-      out << "# Triangles ref " << static_cast<int>(g + 1) << ' ' << std::string_view(groups.surfaces[g].name) << '\n';
+    for (const TetGroup& group : groups.volumes)
+      out << "# Tetrahedra ref " << group.tag << ' ' << std::string_view(group.name) << '\n';
+    for (const FaceGroup& group : groups.surfaces)
+      out << "# Triangles ref " << group.tag << ' ' << std::string_view(group.name) << '\n';
 
     out << "Vertices\n" << mesh.num_vertices() << '\n';
     for (const auto& p : mesh.points) out << p.x() << ' ' << p.y() << ' ' << p.z() << " 0\n";
@@ -36,8 +36,8 @@ void write_medit(const TetMesh& mesh, const MeshGroups& groups, const std::strin
     }
 
     out << "Triangles\n" << mesh_io::group_triangle_count(groups) << '\n';
-    mesh_io::for_each_group_triangle(mesh, groups, [&](int group, const auto& face) {
-      out << face[0] + 1 << ' ' << face[1] + 1 << ' ' << face[2] + 1 << ' ' << group + 1 << '\n';
+    mesh_io::for_each_group_triangle(mesh, groups, [&](int tag, const auto& face) {
+      out << face[0] + 1 << ' ' << face[1] + 1 << ' ' << face[2] + 1 << ' ' << tag << '\n';
     });
     out << "End\n";
   });

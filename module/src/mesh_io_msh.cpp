@@ -54,13 +54,11 @@ Partition partition_by_membership(std::int64_t key_count, const std::vector<std:
   return sorted;
 }
 
-// The same in both versions: physical tags 1, 2, ... per dimension, in group order.
+// The same in both versions: the groups' own tags.
 void write_physical_names(TextWriter& out, const MeshGroups& groups) {
   out << "$PhysicalNames\n" << static_cast<int>(groups.volumes.size() + groups.surfaces.size()) << '\n';
-  for (std::size_t g = 0; g < groups.volumes.size(); ++g)
-    out << "3 " << static_cast<int>(g + 1) << " \"" << std::string_view(groups.volumes[g].name) << "\"\n";
-  for (std::size_t g = 0; g < groups.surfaces.size(); ++g)
-    out << "2 " << static_cast<int>(g + 1) << " \"" << std::string_view(groups.surfaces[g].name) << "\"\n";
+  for (const TetGroup& group : groups.volumes) out << "3 " << group.tag << " \"" << std::string_view(group.name) << "\"\n";
+  for (const FaceGroup& group : groups.surfaces) out << "2 " << group.tag << " \"" << std::string_view(group.name) << "\"\n";
   out << "$EndPhysicalNames\n";
 }
 
@@ -89,22 +87,22 @@ void write_msh41(const TetMesh& mesh, const MeshGroups& groups, const std::strin
       out << box.min.x() << ' ' << box.min.y() << ' ' << box.min.z() << ' ' << box.max.x() << ' '
           << box.max.y() << ' ' << box.max.z();
     };
-    auto physical_tags = [&](const std::vector<int>& member_of) {
+    auto physical_tags = [&](const std::vector<int>& member_of, const auto& same_dimension) {
       out << ' ' << static_cast<int>(member_of.size());
-      for (int g : member_of) out << ' ' << g + 1;
+      for (int g : member_of) out << ' ' << same_dimension[g].tag;
     };
     out << "$Entities\n0 0 " << static_cast<int>(surfaces.entity_groups.size()) << ' '
         << static_cast<int>(volumes.entity_groups.size()) << '\n';
     for (std::size_t e = 0; e < surfaces.entity_groups.size(); ++e) {
       out << static_cast<int>(e + 1) << ' ';
       bounding_box();
-      physical_tags(surfaces.entity_groups[e]);
+      physical_tags(surfaces.entity_groups[e], groups.surfaces);
       out << " 0\n";
     }
     for (std::size_t e = 0; e < volumes.entity_groups.size(); ++e) {
       out << static_cast<int>(e + 1) << ' ';
       bounding_box();
-      physical_tags(volumes.entity_groups[e]);
+      physical_tags(volumes.entity_groups[e], groups.volumes);
       out << " 0\n";
     }
     out << "$EndEntities\n";
@@ -159,14 +157,14 @@ void write_msh22(const TetMesh& mesh, const MeshGroups& groups, const std::strin
     // elementary entity of a group's copy of an element is the group's own, so that no entity holds an
     // element twice.
     std::int64_t number = 0;
-    auto element = [&](int type, int group, const auto& vertices) {
-      out << ++number << ' ' << type << " 2 " << group + 1 << ' ' << group + 1;
+    auto element = [&](int type, int tag, const auto& vertices) {
+      out << ++number << ' ' << type << " 2 " << tag << ' ' << tag;
       for (const VertexId v : vertices) out << ' ' << v + 1;
       out << '\n';
     };
     out << "$Elements\n" << mesh_io::group_triangle_count(groups) + mesh_io::group_tet_count(groups) << '\n';
-    mesh_io::for_each_group_triangle(mesh, groups, [&](int group, const auto& face) { element(2, group, face); });
-    mesh_io::for_each_group_tet(mesh, groups, [&](int group, TetId, const auto& tet) { element(4, group, tet); });
+    mesh_io::for_each_group_triangle(mesh, groups, [&](int tag, const auto& face) { element(2, tag, face); });
+    mesh_io::for_each_group_tet(mesh, groups, [&](int tag, TetId, const auto& tet) { element(4, tag, tet); });
     out << "$EndElements\n";
   });
 }

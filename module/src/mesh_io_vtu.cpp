@@ -114,22 +114,22 @@ void write_vtu(const TetMesh& mesh, const MeshGroups& groups, const std::string&
   }
   const std::int64_t tets = mesh_io::group_tet_count(groups);
   const std::int64_t triangles = mesh_io::group_triangle_count(groups);
-  const int volume_groups = static_cast<int>(groups.volumes.size());
 
   write_file_atomically(path, [&](std::ostream& out) {
     out << "<?xml version=\"1.0\"?>\n"
-           "<!-- meccano-immerse: cell data `group` holds the tag of each cell's group, named in the field data "
-           "(3D groups first, then 2D groups; an element is a cell once per group it is in); "
+           "<!-- meccano-immerse: cell data `group` holds the tag of each cell's group; the field data name the "
+           "groups (tag, dimension), tags being per dimension as in MSH; tets of the 3D groups come first, then "
+           "the triangles of the 2D groups, an element once per group it is in; "
            "quality_meccano and quality_equilateral are 1 on triangles. -->\n"
            "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
            "<UnstructuredGrid>\n<FieldData>\n";
-    auto name_tag = [&out](const std::string& name, int tag) {
-      out << "<DataArray type=\"Int32\" Name=\"" << xml_escaped(name) << "\" NumberOfTuples=\"1\" format=\"ascii\">"
-          << tag << "</DataArray>\n";
+    auto name_group = [&out](const std::string& name, int tag, int dimension) {
+      out << "<DataArray type=\"Int32\" Name=\"" << xml_escaped(name)
+          << "\" NumberOfComponents=\"2\" NumberOfTuples=\"1\" format=\"ascii\">" << tag << ' ' << dimension
+          << "</DataArray>\n";
     };
-    for (int g = 0; g < volume_groups; ++g) name_tag(groups.volumes[g].name, g + 1);
-    for (std::size_t g = 0; g < groups.surfaces.size(); ++g)
-      name_tag(groups.surfaces[g].name, volume_groups + static_cast<int>(g) + 1);
+    for (const TetGroup& group : groups.volumes) name_group(group.name, group.tag, 3);
+    for (const FaceGroup& group : groups.surfaces) name_group(group.name, group.tag, 2);
     out << "</FieldData>\n<Piece NumberOfPoints=\"" << mesh.num_vertices() << "\" NumberOfCells=\"" << tets + triangles
         << "\">\n<Points>\n";
     write_data_array<double>(out, "Name=\"Points\" NumberOfComponents=\"3\"", 3 * std::int64_t{mesh.num_vertices()},
@@ -167,7 +167,7 @@ void write_vtu(const TetMesh& mesh, const MeshGroups& groups, const std::string&
     out << "</Cells>\n<CellData Scalars=\"group\">\n";
     write_data_array<std::int32_t>(
         out, "Name=\"group\"", tets + triangles,
-        per_cell([](int group, TetId) { return group + 1; }, [&](int group) { return volume_groups + group + 1; }));
+        per_cell([](int tag, TetId) { return tag; }, [](int tag) { return tag; }));
     write_data_array<double>(
         out, "Name=\"quality_meccano\"", tets + triangles,
         per_cell([&](int, TetId t) { return meccano_quality[t]; }, [](int) { return triangle_quality; }));

@@ -438,14 +438,14 @@ MeshGroups output_groups(const InsertionResult& result, Stage last_stage) {
   for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s) {
     const SurfaceInsertion& inserted = result.surfaces[s];
     if (last_stage != Stage::smoothing) {
-      TetGroup volume{"volumetric_" + inserted.name, {}};
+      TetGroup volume{"volumetric_" + inserted.name, domain_tag + 1 + s, {}};
       for (TetId t = 0; t < result.mesh.num_tets(); ++t)
         if (inserted.volumetric[t]) volume.tets.push_back(t);
       groups.volumes.push_back(std::move(volume));
     }
     if (inserted.healing_stats.side != 0)
       groups.surfaces.push_back(
-          {"interface_" + inserted.name,
+          {"interface_" + inserted.name, interface_tag(s),
            interface_faces(result.mesh, inserted.volumetric, s, inserted.healing_stats.side).faces});
   }
   return groups;

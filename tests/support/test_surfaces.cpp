@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 #include <utility>
 
 namespace meccano::testing {
@@ -267,6 +269,15 @@ double distance_to_rim(const TriangleSurface& surface, const Eigen::Vector3d& x)
     i = j;
   }
   return best;
+}
+
+std::string write_obj(const std::string& path, const TriangleSurface& surface) {
+  std::ofstream out(path);
+  out.precision(17);
+  for (const auto& p : surface.points) out << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  for (const auto& t : surface.triangles) out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+  if (!out.flush()) throw std::runtime_error("cannot write " + path);
+  return path;
 }
 
 }  // namespace meccano::testing

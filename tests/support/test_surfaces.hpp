@@ -72,6 +72,9 @@ TriangleSurface scaled_into(TriangleSurface surface, const Box& box);
 double largest_extent(const TriangleSurface& surface);
 Box box_around(const TriangleSurface& surface, double margin = 0.1);
 
+// The surface as a Wavefront OBJ file at `path` (exact: 17 digits); returns the path.
+std::string write_obj(const std::string& path, const TriangleSurface& surface);
+
 // The shared fault file of that name (../shared/data/faults beside the checkout, GOCAD TSurf, UTM
 // metres), or an empty string when the data is not there: tests that need it skip.
 std::string shared_fault(const std::string& file);

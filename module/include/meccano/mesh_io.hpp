@@ -1,34 +1,39 @@
-// Mesh output with named groups, in the formats solvers and viewers read.
+// Mesh output with named, numbered groups, in the formats solvers and viewers read.
 //
-// Groups: named sets of tets (3D groups) and of faces (2D groups). A face is given by a tet and its local
-// face and is written with its normal pointing out of that tet, so the caller fixes each group's
-// orientation; tets are written positively oriented. standard_groups() gives what every output carries:
-// `domain` (all tets), the box sides `xmin` ... `zmax` (outward normals), and one group per interface
-// tag. Group names may not be empty nor hold '"' or control characters; every tet and face of a group
-// must exist (std::invalid_argument otherwise). Only elements of some group are written; every vertex is.
+// Groups: named sets of tets (3D groups) and of faces (2D groups), each with a tag (its number), unique
+// within its dimension. A face is given by a tet and its local face and is written with its normal
+// pointing out of that tet, so the caller fixes each group's orientation; tets are written positively
+// oriented. standard_groups() gives what every output carries, numbered as every writer of the project
+// numbers it (doc/user_guide.md, "Tags"):
+//   3D  `domain` 1 (all tets); other 3D groups (the stages' `volumetric_NAME`) 2, 3, ...
+//   2D  the box sides `xmin` 1, `xmax` 2, `ymin` 3, `ymax` 4, `zmin` 5, `zmax` 6 (outward normals), and
+//       `interface_NAME` 7, 8, ... for the surfaces in input order (= the face tags of tet_mesh.hpp).
+// Group names may not be empty nor hold '"' or control characters; tags must be positive and unique per
+// dimension; every tet and face of a group must exist (std::invalid_argument otherwise). Only elements
+// of some group are written; every vertex is.
 //
-// The formats (write_mesh picks one from the file's extension):
-//   .msh   Gmsh MSH 4.1 ASCII (write_msh41, the default): groups may overlap (a tet in `domain` and in
-//          `volumetric_1`); elements are written once, in entities that partition them by group
-//          membership, and every physical group is the union of its entities.
-//          Gmsh MSH 2.2 ASCII (write_msh22, for older readers): physical tags 1, 2, ... per dimension in
-//          group order; an element in several groups is written once per group (Gmsh's convention),
-//          each group in an elementary entity of its own (tag = physical tag), so that a reader counts
-//          every group's elements exactly.
+// The formats (write_mesh picks one from the file's extension) all carry the groups' own tags:
+//   .msh   Gmsh MSH 4.1 ASCII (write_msh41, the default): physical groups with the groups' tags. Groups
+//          may overlap (a tet in `domain` and in `volumetric_1`); elements are written once, in
+//          entities that partition them by group membership, and every physical group is the union of
+//          its entities.
+//          Gmsh MSH 2.2 ASCII (write_msh22, for older readers): an element in several groups is written
+//          once per group (Gmsh's convention), each group in an elementary entity of its own (entity
+//          tag = physical tag), so that a reader counts every group's elements exactly.
 //   .vtu   VTK XML UnstructuredGrid (write_vtu, for ParaView), little-endian, base64 binary arrays with
 //          UInt64 headers (millions of tets): points Float64 x 3; cells are the tets of every 3D group
 //          (VTK_TETRA), group by group, then the faces of every 2D group (VTK_TRIANGLE), an element once
 //          per group like MSH 2.2; connectivity Int32, offsets Int64. Cell data:
-//            group                Int32, the group's tag: 3D groups 1..n3 in order, then 2D groups
-//                                 n3 + 1 ... (threshold on it to see one interface or box side);
+//            group                Int32, the tag of the cell's group (tags are per dimension, as in
+//                                 MSH: the cell type tells a tet of `domain` from a face of `xmin`);
 //            quality_meccano      Float64, mean ratio of the tet against its computational (meccano)
 //                                 counterpart (quality.hpp), negative for an inverted tet;
 //            quality_equilateral  Float64, mean ratio against the equilateral tet;
 //            both are 1 on triangles, a neutral value that never shows up among bad elements.
-//          Field data: one Int32 array per group, named like the group, holding its tag.
-//   .mesh  Medit ASCII (write_medit, MeshVersionFormatted 2): a tet once, with reference = 1-based index
-//          of its first 3D group (`domain` = 1); a face once per 2D group, with reference = 1-based index
-//          of that group (standard groups: box sides 1..6 in the order xmin..zmax, then the interfaces).
+//          Field data: one Int32 array of 2 components per group, named like the group, holding its
+//          tag and dimension (meshio's `field_data` convention).
+//   .mesh  Medit ASCII (write_medit, MeshVersionFormatted 2): a tet once, with reference = the tag of
+//          its first 3D group (`domain`: 1); a face once per 2D group, with reference = that group's tag.
 //          Comment lines after the header name the references: `# Tetrahedra ref 1 domain`,
 //          `# Triangles ref 7 interface_patch`.
 // Writes are atomic (atomic_file.hpp): a failed write leaves no file; InputError names the path.
@@ -42,18 +47,15 @@
 
 namespace meccano {
 
-struct FaceRef {
-  TetId tet;
-  int local_face;
-};
-
 struct TetGroup {
   std::string name;
+  int tag;  // unique among the 3D groups
   std::vector<TetId> tets;
 };
 
 struct FaceGroup {
   std::string name;
+  int tag;  // unique among the 2D groups
   std::vector<FaceRef> faces;
 };
 
@@ -63,7 +65,7 @@ struct MeshGroups {
 };
 
 // `domain`, the six box sides, and `interface_NAME` for every interface tag in use, NAME taken from
-// `interface_names` (index = interface index). Interface faces are oriented out of the tet on the side
+// `interface_names` (index = interface index), numbered as above. Interface faces are oriented out of the tet on the side
 // of the face where the tag was set first in tet order; stages that know the surface's normal build
 // their own group instead.
 MeshGroups standard_groups(const TetMesh& mesh, const std::vector<std::string>& interface_names = {});

@@ -110,7 +110,8 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
 
 // `domain`, the box sides, and `interface_NAME` for every surface's S_M (once built), oriented like the
 // surface; at the inspection stages (last_stage before smoothing) also `volumetric_NAME` for every
-// surface's V_M. The final mesh leaves V_M out: formats that write an element once per group (MSH 2.2,
+// surface's V_M. Tags as in mesh_io.hpp: surface k's interface is 7 + k whichever S_M exist, its V_M
+// 2 + k. The final mesh leaves V_M out: formats that write an element once per group (MSH 2.2,
 // VTU) would otherwise hold its tets twice.
 MeshGroups output_groups(const InsertionResult& result, Stage last_stage = Stage::smoothing);
 

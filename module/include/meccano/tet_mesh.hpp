@@ -37,7 +37,9 @@ inline constexpr int grid_bits = 30;
 inline constexpr std::int64_t grid_cell = std::int64_t{1} << grid_bits;
 using GridPoint = std::array<std::int64_t, 3>;
 
-// Face tags: 0 = untagged, 1..6 = box sides, 7.. = interfaces of immersed surfaces.
+// Face tags: 0 = untagged, 1..6 = box sides, 7.. = interfaces of immersed surfaces. The mesh files use
+// the same numbers for their 2D groups, and domain_tag for the volume (mesh_io.hpp).
+inline constexpr int domain_tag = 1;
 using FaceTag = std::uint8_t;
 inline constexpr FaceTag no_face_tag = 0;
 inline constexpr int max_interfaces = 255 - 6;
@@ -74,6 +76,14 @@ struct MeccanoGrid {
   GridPoint upper_corner() const;  // grid coordinates of box.max
 };
 
+// A face of the mesh as a face of one of its tets: local_face f is the face opposite mesh.tets[tet][f]
+// (Kossaczky order, like neighbours and face_tags). A solver that builds its cells from oriented_tet(tet)
+// finds that face at index oriented_local_face(tet, local_face) of its own cell.
+struct FaceRef {
+  TetId tet;
+  int local_face;
+};
+
 struct TetMesh {
   MeccanoGrid meccano;
 
@@ -93,6 +103,10 @@ struct TetMesh {
 
   // The tet's vertices ordered so that it is positively oriented (what file formats expect).
   std::array<VertexId, 4> oriented_tet(TetId t) const;
+  // Local face f (opposite tets[t][f]) numbered as in oriented_tet(t): the index k of the vertex
+  // oriented_tet(t)[k] it is opposite. oriented_tet swaps the last two vertices of a negatively oriented
+  // tet, so faces 2 and 3 swap there.
+  int oriented_local_face(TetId t, int f) const { return kinds[t].negative() && f >= 2 ? 5 - f : f; }
   // The vertices of local face f, ordered so that the right-hand normal points out of tet t.
   std::array<VertexId, 3> outward_face(TetId t, int f) const;
   // The physical positions of the tet's vertices, in Kossaczky order.

@@ -16,3 +16,13 @@ set_tests_properties(consumer_install consumer_find_package consumer_pkg_config 
   TIMEOUT 600)
 set_tests_properties(consumer_install PROPERTIES FIXTURES_SETUP meccano_installed)
 set_tests_properties(consumer_find_package consumer_pkg_config PROPERTIES FIXTURES_REQUIRED meccano_installed)
+
+# The deal.II adapter, when it is built: a deal.II program against the installed target (the user
+# guide's example).
+if(TARGET meccano_dealii)
+  add_test(NAME consumer_dealii COMMAND bash ${MECCANO_CONSUMER_SCRIPT} dealii ${MECCANO_CONSUMER_WORK})
+  set_tests_properties(consumer_dealii PROPERTIES
+    ENVIRONMENT "CMAKE=${CMAKE_COMMAND};CXX=${CMAKE_CXX_COMPILER}"
+    TIMEOUT 900
+    FIXTURES_REQUIRED meccano_installed)
+endif()

@@ -6,6 +6,9 @@
 #   run_consumer.sh cmake WORK               find_package(MeccanoImmerse) project in WORK/cmake, then run
 #   run_consumer.sh pkg-config WORK LIBDIR   c++ $(pkg-config --cflags --libs meccano-immerse) in
 #                                            WORK/pkg-config (.pc under WORK/prefix/LIBDIR), then run
+#   run_consumer.sh dealii WORK              find_package(MeccanoImmerse COMPONENTS dealii) project
+#                                            tests/consumer_dealii in WORK/dealii; runs its program on
+#                                            a mesh of the library, then on a file of the installed tool
 #
 # Every step starts from an emptied directory, so nothing left by an earlier run can hide a packaging
 # defect. CMAKE and CXX name the cmake and the compiler to use (default: those on PATH).
@@ -14,7 +17,7 @@ set -euo pipefail
 consumer_dir=$(cd "$(dirname "$0")" && pwd)
 cmake=${CMAKE:-cmake}
 cxx=${CXX:-c++}
-usage="usage: run_consumer.sh install WORK BUILD_DIR | cmake WORK | pkg-config WORK LIBDIR"
+usage="usage: run_consumer.sh install WORK BUILD_DIR | cmake WORK | pkg-config WORK LIBDIR | dealii WORK"
 [ $# -ge 2 ] || { echo "$usage" >&2; exit 2; }
 step=$1
 prefix=$2/prefix
@@ -49,6 +52,16 @@ case $step in
     "$cxx" -std=c++20 -O2 "$consumer_dir/main.cpp" -o "$out/consumer" $(pkg-config --cflags --libs meccano-immerse)
     # Only needed for a shared library (BUILD_SHARED_LIBS=ON); pkg-config adds no run path.
     LD_LIBRARY_PATH=$(pkg-config --variable=libdir meccano-immerse) "$out/consumer"
+    ;;
+  dealii)
+    fresh_dir "$out"
+    "$cmake" -S "$consumer_dir/../consumer_dealii" -B "$out" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release
+    found_under_prefix MeccanoImmerse "$(sed -n 's/^MeccanoImmerse_DIR:PATH=//p' "$out/CMakeCache.txt")"
+    "$cmake" --build "$out"
+    "$out/flux_jump"
+    "$prefix/bin/meccano-immerse" --box 0,0,0,1,1,1 --level 1 --surface "$consumer_dir/../../meshes/spherical_cap.obj:cap" \
+      --resolution 0.08 --quiet --output "$out/cap.msh"
+    "$out/flux_jump" "$out/cap.msh" cap
     ;;
   *)
     echo "$usage" >&2

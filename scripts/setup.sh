@@ -9,7 +9,8 @@ packages=(
   libgtest-dev libbenchmark-dev       # tests and benchmarks
   libgmsh-dev gmsh                    # independent MSH reader in the tests, reference meshes
   libtet1.5-dev tetgen                # the TetGen reference mesher (meshes/reference-tetgen)
-  libdeal.ii-dev                      # the demo solver (solver_demo/): deal.II with Trilinos and MPI
+  libdeal.ii-dev                      # the adapter meccano::dealii and the demo solver: deal.II with Trilinos and MPI
+  python3-dolfinx python3-gmsh        # the user guide's dolfinx example, run by CTest (tests/dolfinx/)
   python3 python3-matplotlib python3-numpy   # plots in doc/
   clang libclang-rt-14-dev libomp-dev  # libFuzzer targets (tests/fuzz/): clang's sanitizers, libFuzzer, OpenMP
 )

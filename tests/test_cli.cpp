@@ -436,11 +436,15 @@ TEST_F(CliTest, WritesEveryFormatInOneRunWithBothInterfaces) {
     ASSERT_GT(sizes.count(name) ? sizes.at(name) : 0u, 0u) << name;
 
   const testing::VtuFile vtu = testing::read_vtu(path("mesh.vtu"));
-  std::map<int, std::size_t> cells_of_tag;
-  for (const double tag : vtu.arrays.at("group")) ++cells_of_tag[static_cast<int>(tag)];
+  std::map<std::pair<int, int>, std::size_t> cells_of_group;  // (tag, dimension): tags are per dimension
+  const auto& types = vtu.arrays.at("types");
+  for (std::size_t c = 0; c < types.size(); ++c)
+    ++cells_of_group[{static_cast<int>(vtu.arrays.at("group")[c]), types[c] == 10 ? 3 : 2}];
   ASSERT_EQ(vtu.field.size(), sizes.size());
-  for (const auto& [name, tag] : vtu.field)
-    EXPECT_EQ(cells_of_tag[static_cast<int>(tag.at(0))], sizes.at(name)) << name;
+  for (const auto& [name, tag_and_dimension] : vtu.field)
+    EXPECT_EQ((cells_of_group[{static_cast<int>(tag_and_dimension.at(0)), static_cast<int>(tag_and_dimension.at(1))}]),
+              sizes.at(name))
+        << name;
 
   // Box sides are references 1..6, the interfaces 7 and 8, in the order of the surfaces.
   const std::string medit = file_text(path("mesh.mesh"));

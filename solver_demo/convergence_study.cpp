@@ -4,7 +4,6 @@
 
 #include "command_line.hpp"
 #include "cube_example.hpp"
-#include "interface_mesh.hpp"
 #include "interface_poisson.hpp"
 
 #include <meccano/atomic_file.hpp>
@@ -57,7 +56,7 @@ Level level_parameters(int level) {
   return {base_level, resolution, static_cast<int>(std::ceil(2.0 * 0.6 / resolution))};
 }
 
-InterfaceMesh module_mesh(const Level& level, double& seconds) {
+meccano::DealiiMesh module_mesh(const Level& level, double& seconds) {
   const auto start = std::chrono::steady_clock::now();
   const meccano::Box box{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}};
   const std::vector<meccano::TriangleSurface> surfaces{triangulate_cube_example(level.surface_cells)};
@@ -66,7 +65,7 @@ InterfaceMesh module_mesh(const Level& level, double& seconds) {
   options.resolution = level.resolution;
   const meccano::InsertionResult result =
       meccano::insert_surfaces(meccano::make_cube_meccano(box, level.base_level), surfaces, options);
-  InterfaceMesh mesh = interface_mesh_from_insertion(result);
+  meccano::DealiiMesh mesh = meccano::dealii_mesh(result);
   seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return mesh;
 }
@@ -110,14 +109,14 @@ void study(MPI_Comm communicator, const Options& options) {
   for (int l = 0; l < levels; ++l) {
     const auto start = std::chrono::steady_clock::now();
     const Level level = level_parameters(l);
-    InterfaceMesh mesh;  // rank 0 meshes; the solver distributes
+    meccano::DealiiMesh mesh;  // rank 0 meshes; the solver distributes
     double mesh_seconds = 0.0;
     NormalError normals;
     if (root) {
       mesh = module_mesh(level, mesh_seconds);
-      normals = cube_example_normal_error(mesh);
+      normals = cube_example_normal_error(mesh.interface());
     }
-    const SolveReport report = solve_interface_problem(communicator, mesh, degree, problem);
+    const SolveReport report = solve_interface_problem(communicator, mesh, "", degree, problem);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!root) continue;
 

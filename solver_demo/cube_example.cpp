@@ -55,11 +55,6 @@ ValueAndGradient smooth_part(const Eigen::Vector3d& p) {
   return {e * s, {2.0 * e * c, e * c, e * s}};
 }
 
-Eigen::Vector3d triangle_normal(const InterfaceMesh& mesh, const std::array<unsigned int, 3>& t) {
-  const auto point = [&](int i) { return Eigen::Vector3d(mesh.points[t[i]].data()); };
-  return (point(1) - point(0)).cross(point(2) - point(0));
-}
-
 }  // namespace
 
 double cube_example_height(double x, double y) { return height(x, y).s; }
@@ -119,34 +114,33 @@ meccano::TriangleSurface triangulate_cube_example(int n) {
   return surface;
 }
 
-SurfaceMatch match_cube_example_surface(const InterfaceMesh& mesh) {
+SurfaceMatch match_cube_example_surface(const meccano::DealiiInterface& interface) {
   SurfaceMatch match;
+  if (interface.corners.empty()) {
+    match.max_deviation = std::numeric_limits<double>::infinity();
+    return match;
+  }
   double edge_sum = 0.0;
-  for (const auto& t : mesh.interface)
-    for (int i = 0; i < 3; ++i)
-      edge_sum += (Eigen::Vector3d(mesh.points[t[i]].data()) - Eigen::Vector3d(mesh.points[t[(i + 1) % 3]].data())).norm();
-  match.tolerance = mesh.interface.empty() ? 0.0 : 0.05 * edge_sum / (3.0 * static_cast<double>(mesh.interface.size()));
-  for (const auto& t : mesh.interface)
-    for (const unsigned int v : t) {
-      const auto& [x, y, z] = mesh.points[v];
-      const bool over_q = x >= origin - match.tolerance && x <= origin + side + match.tolerance &&
-                          y >= origin - match.tolerance && y <= origin + side + match.tolerance;
-      match.max_deviation = std::max(match.max_deviation,
-                                     over_q ? std::abs(z - cube_example_height(x, y)) : std::numeric_limits<double>::infinity());
-    }
-  if (mesh.interface.empty()) match.max_deviation = std::numeric_limits<double>::infinity();
+  for (std::size_t t = 0; t < interface.triangles(); ++t)
+    for (int i = 0; i < 3; ++i) edge_sum += (corner(interface, t, i) - corner(interface, t, (i + 1) % 3)).norm();
+  match.tolerance = 0.05 * edge_sum / static_cast<double>(interface.corners.size());
+  for (const dealii::Point<3>& p : interface.corners) {
+    const double x = p[0], y = p[1];
+    const bool over_q = x >= origin - match.tolerance && x <= origin + side + match.tolerance &&
+                        y >= origin - match.tolerance && y <= origin + side + match.tolerance;
+    match.max_deviation = std::max(match.max_deviation, over_q ? std::abs(p[2] - cube_example_height(x, y))
+                                                               : std::numeric_limits<double>::infinity());
+  }
   return match;
 }
 
-NormalError cube_example_normal_error(const InterfaceMesh& mesh) {
+NormalError cube_example_normal_error(const meccano::DealiiInterface& interface) {
   NormalError error;
   double area_sum = 0.0, weighted_sum = 0.0;
-  for (const auto& t : mesh.interface) {
-    const Eigen::Vector3d normal = triangle_normal(mesh, t);
-    const Eigen::Vector3d centroid =
-        (Eigen::Vector3d(mesh.points[t[0]].data()) + Eigen::Vector3d(mesh.points[t[1]].data()) +
-         Eigen::Vector3d(mesh.points[t[2]].data())) / 3.0;
-    const double cosine = std::abs(normal.normalized().dot(cube_example_normal(centroid.x(), centroid.y())));
+  for (std::size_t t = 0; t < interface.triangles(); ++t) {
+    const Eigen::Vector3d normal = triangle_normal(interface, t);
+    const Eigen::Vector3d center = centroid(interface, t);
+    const double cosine = std::abs(normal.normalized().dot(cube_example_normal(center.x(), center.y())));
     const double angle = std::acos(std::min(1.0, cosine)) * 180.0 / pi;
     error.per_triangle_deg.push_back(angle);
     error.max_deg = std::max(error.max_deg, angle);

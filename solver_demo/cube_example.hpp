@@ -17,7 +17,7 @@
 // outside the column Q × R).
 #pragma once
 
-#include "interface_mesh.hpp"
+#include "interface_triangles.hpp"
 
 #include <meccano/surface.hpp>
 
@@ -41,23 +41,23 @@ double manufactured_interface_source(const Eigen::Vector3d& p);    // g_S at (x,
 // triangulation as meshes/generate_surfaces.py writes, named "patch".
 meccano::TriangleSurface triangulate_cube_example(int n);
 
-// Whether the interface of `mesh` is S: every interface node lies over Q and within `tolerance` of s
-// in z. The tolerance is relative to the mesh: 5 % of the mean interface edge length, far below the
+// Whether `interface` is S: every corner of its triangles lies over Q and within `tolerance` of s in
+// z. The tolerance is relative to the mesh: 5 % of the interface's mean edge length, far below the
 // distance to any other surface the demo meets, far above the sag of a fine triangulation of S.
 struct SurfaceMatch {
-  double max_deviation = 0.0;  // max |z − s(x, y)| over the interface nodes (∞ if one is outside Q)
+  double max_deviation = 0.0;  // max |z − s(x, y)| over the corners (∞ if one is outside Q)
   double tolerance = 0.0;
   bool matches() const { return max_deviation <= tolerance; }
 };
-SurfaceMatch match_cube_example_surface(const InterfaceMesh& mesh);
+SurfaceMatch match_cube_example_surface(const meccano::DealiiInterface& interface);
 
 // Angles between the interface triangles' normals and S's normal at the point over each centroid, as
 // unoriented lines (a triangle's orientation is a property of the file, not of the approximation).
 struct NormalError {
   double max_deg = 0.0;
   double mean_deg = 0.0;                   // area-weighted
-  std::vector<double> per_triangle_deg;    // in the order of mesh.interface
+  std::vector<double> per_triangle_deg;    // in the order of the interface's triangles
 };
-NormalError cube_example_normal_error(const InterfaceMesh& mesh);
+NormalError cube_example_normal_error(const meccano::DealiiInterface& interface);
 
 }  // namespace solver_demo

@@ -13,9 +13,6 @@
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping_fe.h>
-#include <deal.II/grid/grid_tools.h>
-#include <deal.II/grid/tria.h>
-#include <deal.II/grid/tria_description.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/solver_cg.h>
@@ -29,8 +26,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <stdexcept>
-#include <utility>
 #include <vector>
 
 namespace solver_demo {
@@ -51,32 +48,7 @@ InterfaceProblem unit_source_problem() {
 
 namespace {
 
-Eigen::Vector3d to_eigen(const Point<3>& p) { return {p[0], p[1], p[2]}; }
 Tensor<1, 3> to_tensor(const Eigen::Vector3d& v) { return Point<3>(v.x(), v.y(), v.z()); }
-
-// S's faces carry this manifold id from the coarse mesh until they are harvested. deal.II allows no
-// boundary id on an interior face, and without a Manifold object attached the id changes no geometry.
-constexpr types::manifold_id interface_manifold_id = 7;
-
-// The coarse (here: the only) mesh, built on rank 0: the tets, and S's triangles as interior faces
-// that carry the interface manifold id and the "interior" boundary id.
-void create_coarse_triangulation(const InterfaceMesh& mesh, Triangulation<3>& triangulation) {
-  std::vector<Point<3>> vertices;
-  vertices.reserve(mesh.points.size());
-  for (const auto& [x, y, z] : mesh.points) vertices.emplace_back(x, y, z);
-  std::vector<CellData<3>> cells(mesh.tets.size(), CellData<3>(4));
-  for (std::size_t t = 0; t < mesh.tets.size(); ++t)
-    std::copy(mesh.tets[t].begin(), mesh.tets[t].end(), cells[t].vertices.begin());
-  SubCellData interface;
-  for (const auto& triangle : mesh.interface) {
-    CellData<2> face(3);
-    std::copy(triangle.begin(), triangle.end(), face.vertices.begin());
-    face.boundary_id = numbers::internal_face_boundary_id;
-    face.manifold_id = interface_manifold_id;
-    interface.boundary_quads.push_back(face);
-  }
-  triangulation.create_triangulation(vertices, cells, interface);
-}
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -85,10 +57,10 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 class InterfacePoisson {
  public:
   InterfacePoisson(MPI_Comm communicator, unsigned int degree, const InterfaceProblem& problem);
-  SolveReport run(const InterfaceMesh& mesh, const std::string& vtu_prefix);
+  SolveReport run(const meccano::DealiiMesh& mesh, const std::string& interface_name, const std::string& vtu_prefix);
 
  private:
-  void make_grid(const InterfaceMesh& mesh);
+  void make_grid(const meccano::DealiiMesh& mesh, const std::string& interface_name);
   void setup_system();
   void assemble_system();
   void solve();
@@ -99,8 +71,8 @@ class InterfacePoisson {
   const InterfaceProblem& problem;
 
   parallel::fullydistributed::Triangulation<3> triangulation;
-  // The S faces this rank integrates over: each face once, from the side with the smaller CellId.
-  std::vector<std::pair<Triangulation<3>::active_cell_iterator, unsigned int>> interface_faces;
+  // The S faces this rank integrates over: each face once, from its negative side.
+  std::vector<meccano::InterfaceCellFace> interface_faces;
 
   // Tets are mapped affinely; S is made of flat faces, so higher-order geometry would gain nothing.
   const MappingFE<3> mapping;
@@ -127,41 +99,32 @@ InterfacePoisson::InterfacePoisson(MPI_Comm communicator_, unsigned int degree, 
 
 // Rank 0 builds the whole coarse mesh and METIS cuts it into one part per rank; each rank receives its
 // cells and one layer of ghosts. The manifold id of S's faces survives the distribution. Each rank
-// then harvests the S faces of the cells it owns and resets every manifold id to flat: MappingFE
-// insists (in Debug) that all parts of a cell share the cell's manifold id.
-void InterfacePoisson::make_grid(const InterfaceMesh& mesh) {
-  const unsigned int ranks = Utilities::MPI::n_mpi_processes(communicator);
-  const auto description = TriangulationDescription::Utilities::create_description_from_triangulation_in_groups<3, 3>(
-      [&mesh](Triangulation<3>& serial) { create_coarse_triangulation(mesh, serial); },
-      [](Triangulation<3>& serial, const MPI_Comm&, const unsigned int group_size) {
-        GridTools::partition_triangulation(group_size, serial);  // one group of all ranks: a part per rank
-      },
-      communicator, static_cast<int>(ranks));
-  triangulation.create_triangulation(description);
-
-  interface_faces.clear();
-  double h = 0.0;
-  for (const auto& cell : triangulation.active_cell_iterators()) {
-    if (!cell->is_locally_owned()) continue;
-    for (const unsigned int f : cell->face_indices())
-      if (!cell->at_boundary(f) && cell->face(f)->manifold_id() == interface_manifold_id &&
-          cell->id() < cell->neighbor(f)->id())
-        interface_faces.emplace_back(cell, f);
-    for (const unsigned int l : cell->line_indices()) h = std::max(h, cell->line(l)->diameter());
-  }
+// then harvests the S faces of the cells it owns, by their corners in rank 0's interfaces, and resets
+// every manifold id to flat: MappingFE insists (in Debug) that all parts of a cell share the cell's
+// manifold id.
+void InterfacePoisson::make_grid(const meccano::DealiiMesh& mesh, const std::string& interface_name) {
+  triangulation.create_triangulation(meccano::fullydistributed_description(mesh, communicator));
+  meccano::DealiiMesh every_rank;  // rank 0's interfaces only
+  every_rank.interfaces = Utilities::MPI::broadcast(communicator, mesh.interfaces, 0);
+  const meccano::DealiiInterface& interface = every_rank.interface(interface_name);
+  interface_faces = meccano::interface_cell_faces(triangulation, interface);
   triangulation.set_all_manifold_ids(numbers::flat_manifold_id);
 
+  double h = 0.0;
+  for (const auto& cell : triangulation.active_cell_iterators())
+    if (cell->is_locally_owned())
+      for (const unsigned int l : cell->line_indices()) h = std::max(h, cell->line(l)->diameter());
   report.cells = triangulation.n_global_active_cells();
   report.h = Utilities::MPI::max(h, communicator);
   report.interface_faces = Utilities::MPI::sum<unsigned long long>(interface_faces.size(), communicator);
-  const auto expected = Utilities::MPI::broadcast(communicator, static_cast<unsigned long long>(mesh.interface.size()), 0);
-  if (report.interface_faces != expected)
+  if (report.interface_faces != interface.triangles())
     throw std::logic_error("the distributed mesh has " + std::to_string(report.interface_faces) + " faces on S, the input " +
-                           std::to_string(expected));
+                           std::to_string(interface.triangles()));
 }
 
-// Degrees of freedom, the Dirichlet constraints u = g_D on every box side (every boundary face has
-// boundary id 0: S's faces are interior), and the sparsity of the distributed matrix.
+// Degrees of freedom, the Dirichlet constraints u = g_D on every boundary face (S's faces are interior)
+// whatever its boundary id: 1-6 on the box sides, 0 on the faces a foreign mesh puts in no side group;
+// and the sparsity of the distributed matrix.
 void InterfacePoisson::setup_system() {
   dof_handler.distribute_dofs(fe);
   report.dofs = dof_handler.n_dofs();
@@ -174,7 +137,9 @@ void InterfacePoisson::setup_system() {
   constraints.reinit(locally_relevant_dofs);
   const ScalarFunctionFromFunctionObject<3> boundary_values(
       [this](const Point<3>& p) { return problem.boundary_values(to_eigen(p)); });
-  VectorTools::interpolate_boundary_values(mapping, dof_handler, 0, boundary_values, constraints);
+  std::map<types::boundary_id, const Function<3>*> dirichlet;
+  for (const types::boundary_id id : triangulation.get_boundary_ids()) dirichlet.emplace(id, &boundary_values);
+  VectorTools::interpolate_boundary_values(mapping, dof_handler, dirichlet, constraints);
   constraints.close();
 
   DynamicSparsityPattern dsp(locally_relevant_dofs);
@@ -214,9 +179,10 @@ void InterfacePoisson::assemble_system() {
 
   const QGaussSimplex<2> face_quadrature(fe.degree + 2);
   FEFaceValues<3> fe_face_values(mapping, fe, face_quadrature, update_values | update_quadrature_points | update_JxW_values);
-  for (const auto& [tria_cell, f] : interface_faces) {
-    const DoFHandler<3>::active_cell_iterator cell(&triangulation, tria_cell->level(), tria_cell->index(), &dof_handler);
-    fe_face_values.reinit(cell, f);
+  for (const meccano::InterfaceCellFace& face : interface_faces) {
+    const DoFHandler<3>::active_cell_iterator cell(&triangulation, face.negative->level(), face.negative->index(),
+                                                   &dof_handler);
+    fe_face_values.reinit(cell, face.negative_face);
     cell_rhs = 0;
     for (const unsigned int q : fe_face_values.quadrature_point_indices()) {
       const double g = problem.interface_source(to_eigen(fe_face_values.quadrature_point(q)));
@@ -288,8 +254,8 @@ void InterfacePoisson::evaluate() {
         outflow -= face_gradients[q] * fe_face_values.normal_vector(q) * fe_face_values.JxW(q);
     }
   }
-  for (const auto& [cell, f] : interface_faces) {
-    fe_face_values.reinit(cell, f);
+  for (const meccano::InterfaceCellFace& face : interface_faces) {
+    fe_face_values.reinit(face.negative, face.negative_face);
     for (const unsigned int q : fe_face_values.quadrature_point_indices())
       source += problem.interface_source(to_eigen(fe_face_values.quadrature_point(q))) * fe_face_values.JxW(q);
   }
@@ -341,9 +307,10 @@ void InterfacePoisson::output_results(const std::string& prefix) const {
   }
 }
 
-SolveReport InterfacePoisson::run(const InterfaceMesh& mesh, const std::string& vtu_prefix) {
+SolveReport InterfacePoisson::run(const meccano::DealiiMesh& mesh, const std::string& interface_name,
+                                  const std::string& vtu_prefix) {
   auto start = std::chrono::steady_clock::now();
-  make_grid(mesh);
+  make_grid(mesh, interface_name);
   setup_system();
   report.setup_seconds = seconds_since(start);
 
@@ -364,11 +331,12 @@ SolveReport InterfacePoisson::run(const InterfaceMesh& mesh, const std::string& 
 
 }  // namespace
 
-SolveReport solve_interface_problem(MPI_Comm communicator, const InterfaceMesh& mesh, unsigned int degree,
+SolveReport solve_interface_problem(MPI_Comm communicator, const meccano::DealiiMesh& mesh,
+                                    const std::string& interface_name, unsigned int degree,
                                     const InterfaceProblem& problem, const std::string& vtu_prefix) {
   if (degree != 1 && degree != 2) throw std::invalid_argument("the degree must be 1 or 2, not " + std::to_string(degree));
   InterfacePoisson solver(communicator, degree, problem);
-  return solver.run(mesh, vtu_prefix);
+  return solver.run(mesh, interface_name, vtu_prefix);
 }
 
 }  // namespace solver_demo

@@ -6,18 +6,22 @@
 // v ∈ H¹₀(Ω). S enters only through that surface integral, so the mesh must have S as a set of faces
 // (the module's output); u is continuous across S and its gradient jumps there.
 //
-// Input    an InterfaceMesh (interface_mesh.hpp; only MPI rank 0's copy is read), the degree 1 or 2 of
-//          the continuous Lagrange elements (FE_SimplexP), and the problem's data.
+// Input    the mesh as the deal.II adapter gives it (meccano::DealiiMesh, from an insertion or an MSH
+//          file; only MPI rank 0's copy is read), the name of its interface S (DealiiMesh::interface:
+//          empty for the only one), the degree 1 or 2 of the continuous Lagrange elements
+//          (FE_SimplexP), and the problem's data.
 // Method   deal.II 9.4 on parallel::fullydistributed::Triangulation (any number of MPI ranks, one
-//          included): rank 0 builds the coarse mesh with S's faces marked by a manifold id, METIS
-//          partitions it; each rank keeps the S faces it owns and the manifold ids are reset to flat
-//          before any FEValues. CG with Trilinos ML AMG, relative residual 1e-12.
+//          included), built from meccano::fullydistributed_description: rank 0 builds the coarse mesh
+//          with S's faces marked by their manifold id, METIS partitions it; each rank takes the S faces
+//          of the cells it owns on S's negative side (meccano::interface_cell_faces) and the manifold
+//          ids are reset to flat before any FEValues. u = g_D on every boundary face, whatever its
+//          boundary id (box sides 1-6, other faces 0). CG with Trilinos ML AMG, relative residual 1e-12.
 // Output   a SolveReport: sizes, CG iterations, the flux balance, the solution's norms, and the errors
 //          in L2 and in the H1 seminorm when the exact solution is known; optionally VTU files.
 #pragma once
 
 #include "cube_example.hpp"
-#include "interface_mesh.hpp"
+#include "interface_triangles.hpp"
 
 #include <deal.II/base/mpi.h>
 
@@ -61,10 +65,11 @@ struct SolveReport {
   double postprocess_seconds = 0.0;
 };
 
-// Solves `problem` on `mesh` with elements of `degree`; writes PREFIX.vtu (PREFIX.pvtu and one
+// Solves `problem` on `mesh` with S its interface `interface_name`, elements of `degree`; writes PREFIX.vtu (PREFIX.pvtu and one
 // PREFIX.RANK.vtu per rank under MPI) with u_h, the subdomains, and u_h − I_h u when u is known,
 // unless `vtu_prefix` is empty. Collective over `communicator`.
-SolveReport solve_interface_problem(MPI_Comm communicator, const InterfaceMesh& mesh, unsigned int degree,
+SolveReport solve_interface_problem(MPI_Comm communicator, const meccano::DealiiMesh& mesh,
+                                    const std::string& interface_name, unsigned int degree,
                                     const InterfaceProblem& problem, const std::string& vtu_prefix = "");
 
 }  // namespace solver_demo

@@ -3,10 +3,10 @@
 
 #include "command_line.hpp"
 #include "cube_example.hpp"
-#include "interface_mesh.hpp"
 #include "interface_poisson.hpp"
 
 #include <meccano/atomic_file.hpp>
+#include <meccano/error.hpp>
 #include <meccano/json_writer.hpp>
 
 #include <deal.II/base/mpi.h>
@@ -35,8 +35,10 @@ Otherwise f = 0, g_D = 0 and g_S = 1, and the solution's norms are printed. Both
 balance: int_Omega f + int_S g_S against the outflow -int_boundary grad u_h . n.
 
 Options:
-  --mesh FILE.msh     Gmsh MSH (2.2 or 4.1, ASCII or binary) with linear tets and the group
-                      interface_NAME (from meccano-immerse, reference-gmsh, Gmsh, ...) (required)
+  --mesh FILE.msh     Gmsh MSH (2.2 or 4.1, ASCII or binary) with linear tets and 2D groups
+                      interface_NAME of interior faces (from meccano-immerse, reference-gmsh,
+                      Gmsh, ...), read by meccano::read_dealii_mesh; the groups xmin ... zmax,
+                      where present, must be boundary faces (required)
   --interface NAME    which interface_NAME group is S (default: the file's only one)
   --degree 1|2        polynomial degree (default 1)
   --vtu PREFIX        write PREFIX.vtu (u_h, and u_h - I_h u where u is known; PREFIX.pvtu and
@@ -55,12 +57,12 @@ double relative_flux_difference(const SolveReport& report) {
 }
 
 // The run as JSON: the numbers the text output prints, at full precision.
-void write_report(const std::string& path, const Options& options, const InterfaceMesh& mesh, unsigned int degree,
-                  const SolveReport& report, const std::optional<NormalError>& normals, double read_seconds,
-                  double total_seconds, unsigned int ranks) {
+void write_report(const std::string& path, const Options& options, const meccano::DealiiInterface& interface,
+                  unsigned int degree, const SolveReport& report, const std::optional<NormalError>& normals,
+                  double read_seconds, double total_seconds, unsigned int ranks) {
   meccano::JsonWriter json;
   json.begin_object().key("mesh").value(options.at("--mesh"));
-  json.key("interface").value("interface_" + mesh.interface_name);
+  json.key("interface").value("interface_" + interface.name);
   json.key("degree").value(degree).key("cells").value(report.cells).key("dofs").value(report.dofs);
   json.key("h").value(report.h).key("cg_iterations").value(report.cg_iterations);
   json.key("manufactured").value(normals.has_value());  // the normals are measured against the cube example's S
@@ -81,34 +83,48 @@ void write_report(const std::string& path, const Options& options, const Interfa
   meccano::write_file_atomically(path, [&text](std::ostream& out) { out << text; });
 }
 
+// The interface `name` of the file's mesh (empty: its only one), or an InputError naming the file.
+const meccano::DealiiInterface& file_interface(const meccano::DealiiMesh& mesh, const std::string& path,
+                                               const std::string& name) {
+  try {
+    return mesh.interface(name);
+  } catch (const meccano::InputError& error) {
+    throw meccano::InputError(path + ": " + error.what() + (name.empty() ? " with --interface" : ""));
+  }
+}
+
 void solve(MPI_Comm communicator, const Options& options) {
   const unsigned int degree = options.count("--degree") ? parse_degree(options.at("--degree")) : 1;
   const std::string vtu = options.count("--vtu") ? options.at("--vtu") : "";
+  const std::string interface_name = options.count("--interface") ? options.at("--interface") : "";
   const bool root = dealii::Utilities::MPI::this_mpi_process(communicator) == 0;
 
   // Rank 0 reads the mesh and decides which problem to solve; the solver distributes the mesh.
   const auto start = std::chrono::steady_clock::now();
-  InterfaceMesh mesh;
+  meccano::DealiiMesh mesh;
+  const meccano::DealiiInterface* interface = nullptr;  // S, on rank 0
   SurfaceMatch match;
   if (root) {
-    mesh = read_interface_mesh(options.at("--mesh"), options.count("--interface") ? options.at("--interface") : "");
-    match = match_cube_example_surface(mesh);
+    mesh = meccano::read_dealii_mesh(options.at("--mesh"));
+    interface = &file_interface(mesh, options.at("--mesh"), interface_name);
+    match = match_cube_example_surface(*interface);
   }
   const double read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const bool manufactured = dealii::Utilities::MPI::broadcast(communicator, match.matches(), 0);
   const InterfaceProblem problem = manufactured ? manufactured_problem() : unit_source_problem();
 
-  const SolveReport report = solve_interface_problem(communicator, mesh, degree, problem, vtu);
+  const SolveReport report = solve_interface_problem(communicator, mesh, interface_name, degree, problem, vtu);
   const double total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!root) return;
 
+  const meccano::DealiiInterface& surface = *interface;
   std::vector<TriangleField> fields;
   std::optional<NormalError> normals;
   std::cout << std::setprecision(4) << "mesh        " << options.at("--mesh") << ": " << report.cells << " tets, h = "
-            << report.h << " (longest edge); interface_" << mesh.interface_name << ": " << mesh.interface.size()
-            << " triangles, area " << interface_area(mesh) << '\n';
+            << report.h << " (longest edge); interface_" << surface.name << ": " << surface.triangles()
+            << " triangles, area " << interface_area(surface) << '\n';
   if (manufactured) {
-    normals = cube_example_normal_error(mesh);
+    normals = cube_example_normal_error(surface);
     fields.emplace_back("normal_angle_deg", normals->per_triangle_deg);
     std::cout << "surface     the cube example's (nodes within " << match.max_deviation << " of its formula, tolerance "
               << match.tolerance << "): the manufactured solution\n"
@@ -132,16 +148,12 @@ void solve(MPI_Comm communicator, const Options& options) {
 
   if (!vtu.empty()) {
     std::vector<double> source;
-    for (const auto& t : mesh.interface) {
-      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-      for (const unsigned int v : t) centroid += Eigen::Vector3d(mesh.points[v].data()) / 3.0;
-      source.push_back(problem.interface_source(centroid));
-    }
+    for (std::size_t t = 0; t < surface.triangles(); ++t) source.push_back(problem.interface_source(centroid(surface, t)));
     fields.emplace_back("g_S", std::move(source));
-    write_interface_vtu(mesh, fields, vtu + "_interface.vtu");
+    write_interface_vtu(surface, fields, vtu + "_interface.vtu");
   }
   if (options.count("--report"))
-    write_report(options.at("--report"), options, mesh, degree, report, normals, read_seconds, total_seconds,
+    write_report(options.at("--report"), options, surface, degree, report, normals, read_seconds, total_seconds,
                  dealii::Utilities::MPI::n_mpi_processes(communicator));
 }
 

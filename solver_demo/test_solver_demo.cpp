@@ -1,9 +1,10 @@
-// The demo solver: the manufactured solution's formulas against finite differences, the mesh reader
-// against the module's own meshes and against broken files, and the two programs end to end: errors
-// that shrink with h, the flux balance on another surface, and MPI runs equal to serial ones.
+// The demo solver: the manufactured solution's formulas against finite differences; the deal.II
+// adapter it takes its meshes from (meccano/dealii_mesh.hpp) on the module's meshes in process and in
+// files, on reference-gmsh's, and on broken files; and the two programs end to end: errors that shrink
+// with h, the flux balance on another surface, and MPI runs equal to serial ones.
 
 #include "cube_example.hpp"
-#include "interface_mesh.hpp"
+#include "interface_triangles.hpp"
 
 #include <meccano/cube_meccano.hpp>
 #include <meccano/error.hpp>
@@ -13,6 +14,9 @@
 
 #include <run_command.hpp>
 #include <scratch_directory.hpp>
+#include <test_surfaces.hpp>
+
+#include <deal.II/grid/tria.h>
 
 #include <gtest/gtest.h>
 
@@ -23,6 +27,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <random>
 #include <regex>
 #include <set>
@@ -131,7 +136,10 @@ TEST(CubeExample, TriangulationIsTheExampleFile) {
 }
 
 // ---------------------------------------------------------------------------------------------------
-// Meshes
+// Meshes through the deal.II adapter (meccano/dealii_mesh.hpp)
+
+using Execution = meccano::testing::CommandRun;
+using meccano::testing::run_command;
 
 meccano::InsertionResult insert(const meccano::TriangleSurface& surface, int level, double resolution) {
   meccano::InsertionOptions options;
@@ -145,64 +153,247 @@ meccano::TriangleSurface spherical_cap() {
   return cap;
 }
 
-// Elements by their corners' coordinates, whatever the vertex numbering.
-template <std::size_t n>
-std::set<std::array<std::array<double, 3>, n>> by_position(const InterfaceMesh& mesh,
-                                                           const std::vector<std::array<unsigned int, n>>& elements) {
-  std::set<std::array<std::array<double, 3>, n>> result;
-  for (const auto& element : elements) {
-    std::array<std::array<double, 3>, n> corners;
-    for (std::size_t i = 0; i < n; ++i) corners[i] = mesh.points[element[i]];
-    std::sort(corners.begin(), corners.end());
-    result.insert(corners);
-  }
-  return result;
+using Corner = std::array<double, 3>;
+using Triangle = std::array<Corner, 3>;
+
+Corner corner_of(const dealii::Point<3>& p) { return {p[0], p[1], p[2]}; }
+
+// A cell or face by its corners' coordinates, sorted: the same key whatever the vertex numbering.
+std::vector<Corner> by_position(const std::vector<dealii::Point<3>>& points) {
+  std::vector<Corner> corners;
+  for (const dealii::Point<3>& p : points) corners.push_back(corner_of(p));
+  std::sort(corners.begin(), corners.end());
+  return corners;
 }
 
-bool positively_oriented(const InterfaceMesh& mesh) {
-  return std::all_of(mesh.tets.begin(), mesh.tets.end(), [&](const auto& t) {
-    const auto p = [&](int i) { return Vector3d(mesh.points[t[i]].data()); };
-    return (p(1) - p(0)).dot((p(2) - p(0)).cross(p(3) - p(0))) > 0.0;
+template <class Vertices>
+std::vector<Corner> by_position(const meccano::DealiiMesh& mesh, const Vertices& vertices) {
+  std::vector<dealii::Point<3>> points;
+  for (const auto v : vertices) points.push_back(mesh.vertices[static_cast<std::size_t>(v)]);
+  return by_position(points);
+}
+
+std::set<std::vector<Corner>> cells_by_position(const meccano::DealiiMesh& mesh) {
+  std::set<std::vector<Corner>> cells;
+  for (const dealii::CellData<3>& cell : mesh.cells) cells.insert(by_position(mesh, cell.vertices));
+  return cells;
+}
+
+// The faces with a boundary id (the box sides), by position, with their id.
+std::map<std::vector<Corner>, dealii::types::boundary_id> box_faces_by_position(const meccano::DealiiMesh& mesh) {
+  std::map<std::vector<Corner>, dealii::types::boundary_id> faces;
+  for (const dealii::CellData<2>& face : mesh.faces.boundary_quads)
+    if (face.boundary_id != dealii::numbers::internal_face_boundary_id) {
+      EXPECT_TRUE(faces.emplace(by_position(mesh, face.vertices), face.boundary_id).second);
+    }
+  return faces;
+}
+
+// An interface's triangles with their orientation: each rotated to start at its smallest corner.
+std::set<Triangle> oriented_triangles(const meccano::DealiiInterface& interface) {
+  std::set<Triangle> triangles;
+  for (std::size_t t = 0; t < interface.triangles(); ++t) {
+    Triangle triangle;
+    for (int i = 0; i < 3; ++i) triangle[i] = corner_of(interface.corners[3 * t + i]);
+    std::rotate(triangle.begin(), std::min_element(triangle.begin(), triangle.end()), triangle.end());
+    triangles.insert(triangle);
+  }
+  return triangles;
+}
+
+bool positively_oriented(const meccano::DealiiMesh& mesh) {
+  return std::all_of(mesh.cells.begin(), mesh.cells.end(), [&](const dealii::CellData<3>& cell) {
+    const auto p = [&](int i) { return mesh.vertices[cell.vertices[i]]; };
+    return (p(1) - p(0)) * dealii::cross_product_3d(p(2) - p(0), p(3) - p(0)) > 0.0;
   });
 }
 
 class DemoFiles : public meccano::testing::ScratchDirectoryTest {
  protected:
   DemoFiles() : ScratchDirectoryTest("solver-demo") {}
+
+  // The module's MSH 4.1 file of `result` with its groups changed by `change`, as `name` here.
+  template <class Change>
+  std::string changed_file(const meccano::InsertionResult& result, const std::string& name, Change change) const {
+    meccano::MeshGroups groups = meccano::output_groups(result);
+    change(groups);
+    meccano::write_msh41(result.mesh, groups, path(name));
+    return path(name);
+  }
 };
 
-using InterfaceMeshTest = DemoFiles;
+using AdapterTest = DemoFiles;
 
-// The module's mesh, in process and through its MSH 4.1 and 2.2 files, is the same mesh.
-TEST_F(InterfaceMeshTest, FilesHoldTheModulesMesh) {
+// The module's mesh in process (dealii_mesh) and through its MSH 4.1 and 2.2 files (read_dealii_mesh)
+// is the same mesh: the same cells, box faces with the same side ids, and the same oriented triangles
+// of S under the same name and tag.
+TEST_F(AdapterTest, FilesHoldTheModulesMesh) {
   const meccano::InsertionResult result = insert(triangulate_cube_example(24), 9, 0.1);
-  const InterfaceMesh direct = interface_mesh_from_insertion(result);
-  EXPECT_EQ(direct.interface_name, "patch");
-  EXPECT_EQ(direct.tets.size(), static_cast<std::size_t>(result.mesh.num_tets()));
-  ASSERT_FALSE(direct.interface.empty());
+  const meccano::DealiiMesh direct = meccano::dealii_mesh(result);
+  EXPECT_EQ(direct.cells.size(), static_cast<std::size_t>(result.mesh.num_tets()));
+  EXPECT_TRUE(positively_oriented(direct));
+  ASSERT_EQ(direct.interfaces.size(), 1u);
+  const meccano::DealiiInterface& patch = direct.interface();
+  EXPECT_EQ(patch.name, "patch");
+  EXPECT_EQ(patch.tag, meccano::interface_tag(0));
+  ASSERT_GT(patch.triangles(), 0u);
+  const auto box_faces = box_faces_by_position(direct);
+  std::set<dealii::types::boundary_id> ids;
+  for (const auto& face : box_faces) ids.insert(face.second);
+  EXPECT_EQ(ids, (std::set<dealii::types::boundary_id>{1, 2, 3, 4, 5, 6}));
+
   meccano::write_msh41(result.mesh, meccano::output_groups(result), path("mesh41.msh"));
   meccano::write_msh22(result.mesh, meccano::output_groups(result), path("mesh22.msh"));
   for (const std::string name : {"mesh41.msh", "mesh22.msh"}) {
-    const InterfaceMesh read = read_interface_mesh(path(name));
-    EXPECT_EQ(read.interface_name, "patch") << name;
-    EXPECT_EQ(read.points.size(), direct.points.size()) << name;
-    EXPECT_EQ(read.tets.size(), direct.tets.size()) << name;
-    EXPECT_EQ(by_position(read, read.tets), by_position(direct, direct.tets)) << name;
-    EXPECT_EQ(by_position(read, read.interface), by_position(direct, direct.interface)) << name;
+    const meccano::DealiiMesh read = meccano::read_dealii_mesh(path(name));
+    EXPECT_EQ(read.vertices.size(), direct.vertices.size()) << name;
+    EXPECT_EQ(read.cells.size(), direct.cells.size()) << name;
+    EXPECT_EQ(cells_by_position(read), cells_by_position(direct)) << name;
     EXPECT_TRUE(positively_oriented(read)) << name;
+    EXPECT_EQ(box_faces_by_position(read), box_faces) << name;
+    ASSERT_EQ(read.interfaces.size(), 1u) << name;
+    EXPECT_EQ(read.interface().name, "patch") << name;
+    EXPECT_EQ(read.interface().tag, patch.tag) << name;
+    EXPECT_EQ(oriented_triangles(read.interface()), oriented_triangles(patch)) << name;
   }
-  EXPECT_TRUE(positively_oriented(direct));
 }
 
-TEST_F(InterfaceMeshTest, CubeExampleSurfaceIsRecognised) {
-  const InterfaceMesh patch = interface_mesh_from_insertion(insert(triangulate_cube_example(24), 9, 0.1));
+// A serial Triangulation<3> of `mesh` (create_triangulation): each box face carries the id of its
+// side (xmin = 1: x = 0, xmax = 2: x = 1, ..., zmax = 6: z = 1), every interior face the interior id,
+// exactly S's faces carry S's tag as manifold id; interface_cell_faces lists each triangle of S once,
+// between two neighbours, the negative cell behind the normal, the positive one in front, with the
+// triangle's unit normal, which points up as S's does. Returns the listed faces' normals by triangle.
+std::map<std::vector<Corner>, dealii::Tensor<1, 3>> expect_triangulation_of(const meccano::DealiiMesh& mesh,
+                                                                          const meccano::DealiiInterface& interface) {
+  dealii::Triangulation<3> triangulation;
+  meccano::create_triangulation(mesh, triangulation);
+  EXPECT_EQ(triangulation.n_active_cells(), mesh.cells.size());
+
+  std::array<int, 6> faces_per_side{};
+  std::size_t tagged = 0;
+  for (const auto& face : triangulation.active_face_iterators()) {
+    if (face->manifold_id() == interface.tag) {
+      ++tagged;
+    } else {
+      EXPECT_EQ(face->manifold_id(), dealii::numbers::flat_manifold_id);
+    }
+    if (!face->at_boundary()) {
+      EXPECT_EQ(face->boundary_id(), dealii::numbers::internal_face_boundary_id);
+      continue;
+    }
+    const dealii::types::boundary_id id = face->boundary_id();
+    if (id < 1 || id > 6) {
+      ADD_FAILURE() << "boundary face with id " << int(id) << " at " << face->center();
+      continue;
+    }
+    ++faces_per_side[id - 1];
+    const unsigned int axis = (id - 1) / 2;
+    const double plane = (id - 1) % 2 == 0 ? 0.0 : 1.0;
+    for (unsigned int v = 0; v < 3; ++v) EXPECT_EQ(face->vertex(v)[axis], plane) << "side " << int(id);
+  }
+  for (const int count : faces_per_side) EXPECT_GT(count, 0);
+  EXPECT_EQ(tagged, interface.triangles());
+
+  std::set<std::vector<Corner>> triangles;
+  for (auto corner = interface.corners.begin(); corner != interface.corners.end(); corner += 3)
+    triangles.insert(by_position({corner, corner + 3}));
+  const std::vector<meccano::InterfaceCellFace> faces = meccano::interface_cell_faces(triangulation, interface);
+  EXPECT_EQ(faces.size(), interface.triangles());
+  std::map<std::vector<Corner>, dealii::Tensor<1, 3>> normals;
+  for (const meccano::InterfaceCellFace& face : faces) {
+    const auto shared = face.negative->face(face.negative_face);
+    const std::vector<Corner> corners = by_position({shared->vertex(0), shared->vertex(1), shared->vertex(2)});
+    EXPECT_EQ(triangles.count(corners), 1u) << "not a triangle of S at " << shared->center();
+    EXPECT_TRUE(normals.emplace(corners, face.normal).second) << "listed twice at " << shared->center();
+
+    EXPECT_EQ(face.negative->neighbor(face.negative_face), face.positive);
+    EXPECT_EQ(face.positive->neighbor(face.positive_face), face.negative);
+    EXPECT_EQ(face.positive->face(face.positive_face), shared);
+    const dealii::Point<3> center = shared->center();
+    EXPECT_LT((face.negative->center() - center) * face.normal, 0.0);
+    EXPECT_GT((face.positive->center() - center) * face.normal, 0.0);
+    EXPECT_NEAR(face.normal.norm(), 1.0, 1e-12);
+    EXPECT_NEAR(face.normal * (shared->vertex(1) - shared->vertex(0)), 0.0, 1e-12);
+    EXPECT_NEAR(face.normal * (shared->vertex(2) - shared->vertex(0)), 0.0, 1e-12);
+    EXPECT_GT(face.normal[2], 0.0) << "at " << center;  // the cube example's S faces up
+  }
+  return normals;
+}
+
+// The module's mesh as a serial triangulation; the normals are those of the module's own interface
+// faces (surface_interfaces), S's normals.
+TEST_F(AdapterTest, SerialTriangulationHasSideIdsAndInterfaceFaces) {
+  const meccano::InsertionResult result = insert(triangulate_cube_example(24), 9, 0.1);
+  const meccano::DealiiMesh mesh = meccano::dealii_mesh(result);
+  const auto normals = expect_triangulation_of(mesh, mesh.interface());
+  const std::vector<meccano::SurfaceInterface> surfaces = meccano::surface_interfaces(result);
+  ASSERT_EQ(surfaces.size(), 1u);
+  ASSERT_EQ(normals.size(), surfaces[0].faces.size());
+  for (const meccano::InterfaceFace& face : surfaces[0].faces) {
+    const auto found = normals.find(by_position(mesh, face.vertices));
+    ASSERT_NE(found, normals.end());
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(found->second[k], face.normal[k], 1e-12);
+  }
+}
+
+// A mesh from another mesher: reference-gmsh (Gmsh, the surface's triangles kept as they are) reads
+// through read_dealii_mesh with its side groups and interface, and the demo solves on it.
+TEST_F(AdapterTest, ReferenceGmshFileReads) {
+  const std::string reference_gmsh = MECCANO_REFERENCE_GMSH;
+  if (reference_gmsh.empty()) GTEST_SKIP() << "reference-gmsh is not built (no libgmsh)";
+  const meccano::TriangleSurface surface = triangulate_cube_example(8);
+  meccano::testing::write_obj(path("patch.obj"), surface);
+  const Execution mesher = run_command(reference_gmsh + " --box 0,0,0,1,1,1 --size 0.2 --quiet --surface " +
+                                       path("patch.obj") + ":patch --output " + path("gmsh.msh"));
+  ASSERT_EQ(mesher.status, 0) << mesher.output;
+
+  const meccano::DealiiMesh mesh = meccano::read_dealii_mesh(path("gmsh.msh"));
+  EXPECT_TRUE(positively_oriented(mesh));
+  const meccano::DealiiInterface& patch = mesh.interface("patch");
+  EXPECT_EQ(patch.tag, meccano::interface_tag(0));
+  ASSERT_EQ(patch.triangles(), surface.triangles.size());
+  // Gmsh keeps the input's triangles and their orientation (its coordinates to 16 digits): each triangle of
+  // the interface is one of the input's, by its corners to 1e-9, with the same normal.
+  using Key = std::array<std::array<long long, 3>, 3>;
+  const auto key_of = [](const std::array<Eigen::Vector3d, 3>& corners) {
+    Key key;
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) key[i][k] = std::llround(corners[i][k] * 1e9);
+    std::sort(key.begin(), key.end());
+    return key;
+  };
+  std::map<Key, Vector3d> input_normals;
+  for (const auto& t : surface.triangles) {
+    const std::array<Vector3d, 3> p{surface.points[t[0]], surface.points[t[1]], surface.points[t[2]]};
+    input_normals.emplace(key_of(p), (p[1] - p[0]).cross(p[2] - p[0]));
+  }
+  std::set<Key> found;
+  for (std::size_t t = 0; t < patch.triangles(); ++t) {
+    const auto normal = input_normals.find(key_of({corner(patch, t, 0), corner(patch, t, 1), corner(patch, t, 2)}));
+    ASSERT_NE(normal, input_normals.end()) << "triangle " << t << " at " << centroid(patch, t).transpose();
+    EXPECT_GT(triangle_normal(patch, t).dot(normal->second), 0.0) << "triangle " << t;
+    found.insert(normal->first);
+  }
+  EXPECT_EQ(found.size(), surface.triangles.size());
+  EXPECT_LT(match_cube_example_surface(patch).max_deviation, 1e-12);
+  expect_triangulation_of(mesh, patch);
+
+  const Execution solve = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + path("gmsh.msh"));
+  ASSERT_EQ(solve.status, 0) << solve.output;
+  EXPECT_NE(solve.output.find("the manufactured solution"), std::string::npos) << solve.output;
+  EXPECT_NE(solve.output.find(std::to_string(surface.triangles.size()) + " faces on S"), std::string::npos)
+      << solve.output;
+}
+
+TEST_F(AdapterTest, CubeExampleSurfaceIsRecognised) {
+  const meccano::DealiiMesh mesh = meccano::dealii_mesh(insert(triangulate_cube_example(24), 9, 0.1));
+  const meccano::DealiiInterface& patch = mesh.interface();
   const SurfaceMatch match = match_cube_example_surface(patch);
   EXPECT_TRUE(match.matches());
   EXPECT_LT(match.max_deviation, 0.25 * match.tolerance);  // nodes on a fine triangulation of S
-  const InterfaceMesh cap = interface_mesh_from_insertion(insert(spherical_cap(), 9, 0.1));
-  EXPECT_FALSE(match_cube_example_surface(cap).matches());
+  EXPECT_FALSE(match_cube_example_surface(meccano::dealii_mesh(insert(spherical_cap(), 9, 0.1)).interface()).matches());
   const NormalError normals = cube_example_normal_error(patch);
-  EXPECT_EQ(normals.per_triangle_deg.size(), patch.interface.size());
+  EXPECT_EQ(normals.per_triangle_deg.size(), patch.triangles());
   EXPECT_GT(normals.max_deg, 0.0);
   EXPECT_LT(normals.mean_deg, normals.max_deg);
   EXPECT_LT(normals.max_deg, 20.0);
@@ -217,36 +408,57 @@ void expect_input_error(const std::function<void()>& read, const std::vector<std
   }
 }
 
-TEST_F(InterfaceMeshTest, BadFilesAreRefusedWithTheirDefect) {
+meccano::FaceGroup& group_named(meccano::MeshGroups& groups, const std::string& name) {
+  return *std::find_if(groups.surfaces.begin(), groups.surfaces.end(), [&](const auto& g) { return g.name == name; });
+}
+
+// A second interface, interface_copy: S's triangles again, under tag 8.
+void copy_interface_patch(meccano::MeshGroups& groups) {
+  meccano::FaceGroup copy = group_named(groups, "interface_patch");
+  copy.name = "interface_copy";
+  copy.tag = 8;
+  groups.surfaces.push_back(copy);
+}
+
+// read_dealii_mesh refuses a file with the file's name and the defect; DealiiMesh::interface names
+// the interfaces there are.
+TEST_F(AdapterTest, BadFilesAreRefusedWithTheirDefect) {
   const meccano::InsertionResult result = insert(triangulate_cube_example(24), 9, 0.1);
-  meccano::MeshGroups groups = meccano::output_groups(result);
-  meccano::write_msh41(result.mesh, groups, path("good.msh"));
-  expect_input_error([&] { read_interface_mesh(path("missing.msh")); }, {"missing.msh", "no such file"});
-  expect_input_error([&] { read_interface_mesh(path("good.msh"), "fault"); },
-                     {"good.msh", "interface_fault", "interface_patch"});
-
-  // A second interface group: the name must be given; a box side as interface: not interior faces.
-  meccano::FaceGroup side = *std::find_if(groups.surfaces.begin(), groups.surfaces.end(),
-                                          [](const auto& g) { return g.name == "zmin"; });
-  side.name = "interface_floor";
-  groups.surfaces.push_back(side);
-  meccano::write_msh41(result.mesh, groups, path("two.msh"));
-  expect_input_error([&] { read_interface_mesh(path("two.msh")); }, {"two.msh", "2 2D physical groups", "--interface"});
-  EXPECT_EQ(read_interface_mesh(path("two.msh"), "patch").interface.size(),
-            interface_mesh_from_insertion(result).interface.size());
-  expect_input_error([&] { read_interface_mesh(path("two.msh"), "floor"); },
-                     {"two.msh", "interface_floor", "boundary of the mesh"});
-
-  // Not a mesh at all.
+  expect_input_error([&] { meccano::read_dealii_mesh(path("missing.msh")); }, {"missing.msh", "cannot open"});
   std::ofstream(path("text.msh")) << "$MeshFormat\nnot a mesh\n";
-  expect_input_error([&] { read_interface_mesh(path("text.msh")); }, {"text.msh"});
+  expect_input_error([&] { meccano::read_dealii_mesh(path("text.msh")); }, {"text.msh"});
+
+  const std::string none = changed_file(result, "none.msh", [](meccano::MeshGroups& groups) {
+    std::erase_if(groups.surfaces, [](const auto& g) { return g.name.rfind("interface_", 0) == 0; });
+  });
+  expect_input_error([&] { meccano::read_dealii_mesh(none); }, {"none.msh", "no 2D physical group named interface_NAME"});
+
+  // A box side as an interface: its triangles are on the boundary.
+  const std::string floor = changed_file(result, "floor.msh", [](meccano::MeshGroups& groups) {
+    meccano::FaceGroup side = group_named(groups, "zmin");
+    side.name = "interface_floor";
+    side.tag = 8;
+    groups.surfaces.push_back(side);
+  });
+  expect_input_error([&] { meccano::read_dealii_mesh(floor); },
+                     {"floor.msh", "of interface_floor is on the boundary", "interior faces"});
+
+  // S's faces as a box side: they are interior.
+  const std::string side = changed_file(result, "side.msh", [](meccano::MeshGroups& groups) {
+    group_named(groups, "xmin").faces = group_named(groups, "interface_patch").faces;
+  });
+  expect_input_error([&] { meccano::read_dealii_mesh(side); }, {"side.msh", "of xmin is an interior face"});
+
+  // Two interfaces: the name must be given.
+  const meccano::DealiiMesh mesh = meccano::read_dealii_mesh(changed_file(result, "two.msh", copy_interface_patch));
+  expect_input_error([&] { mesh.interface(); }, {"2 interfaces", "interface_patch, interface_copy", "name the one"});
+  expect_input_error([&] { mesh.interface("fault"); }, {"no interface_fault", "interface_patch, interface_copy"});
+  EXPECT_EQ(mesh.interface("copy").tag, 8);
+  EXPECT_EQ(oriented_triangles(mesh.interface("patch")), oriented_triangles(meccano::dealii_mesh(result).interface()));
 }
 
 // ---------------------------------------------------------------------------------------------------
 // The programs
-
-using Execution = meccano::testing::CommandRun;
-using meccano::testing::run_command;
 
 // The number that `prefix` (a regular expression) first comes before in `text`.
 double number_after_pattern(const std::string& text, const std::string& prefix) {
@@ -307,7 +519,7 @@ TEST_F(Programs, StudyErrorsShrinkWithH) {
 TEST_F(Programs, FluxBalancesOnTheSphericalCap) {
   const meccano::InsertionResult result = insert(spherical_cap(), 12, 0.05);
   meccano::write_msh41(result.mesh, meccano::output_groups(result), path("cap.msh"));
-  const double area = interface_area(interface_mesh_from_insertion(result));
+  const double area = interface_area(meccano::dealii_mesh(result).interface());
   std::vector<double> balance;
   for (const char* degree : {"1", "2"}) {
     const Execution solve = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + path("cap.msh") + " --degree " + degree +
@@ -347,6 +559,24 @@ TEST_F(Programs, TwoRanksGiveTheSerialErrors) {
   EXPECT_TRUE(fs::exists(path("mpi.1.vtu")));
 }
 
+// u = g_D on every boundary face, whatever its boundary id: the same mesh without three of its side
+// groups (those faces get id 0, the others keep 1-6) gives the same solution.
+TEST_F(Programs, EveryBoundaryFaceIsDirichlet) {
+  const meccano::InsertionResult result = insert(triangulate_cube_example(24), 9, 0.1);
+  meccano::write_msh41(result.mesh, meccano::output_groups(result), path("sides.msh"));
+  const std::string fewer = changed_file(result, "fewer.msh", [](meccano::MeshGroups& groups) {
+    std::erase_if(groups.surfaces, [](const auto& g) { return g.name == "xmin" || g.name == "ymax" || g.name == "zmin"; });
+  });
+  const Execution sides = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + path("sides.msh"));
+  const Execution ids_0 = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + fewer);
+  ASSERT_EQ(sides.status, 0) << sides.output;
+  ASSERT_EQ(ids_0.status, 0) << ids_0.output;
+  for (const char* label : {"L2 error", "H1 error", "source", "outflow"}) {
+    const double one = value_after(sides.output, label), other = value_after(ids_0.output, label);
+    EXPECT_NEAR(one, other, 1e-11 * std::abs(one)) << label;
+  }
+}
+
 // --report holds the numbers the text prints, at full precision (the text has 12 digits).
 TEST_F(Programs, ReportHoldsThePrintedNumbers) {
   const meccano::InsertionResult result = insert(triangulate_cube_example(24), 9, 0.1);
@@ -381,7 +611,11 @@ TEST_F(Programs, BadInputAndUsage) {
   const std::string poisson = SOLVER_DEMO_POISSON;
   const Execution missing_group = run_command(poisson + " --mesh " + path("patch.msh") + " --interface fault");
   EXPECT_EQ(missing_group.status, 1);
-  EXPECT_NE(missing_group.output.find("interface_fault"), std::string::npos) << missing_group.output;
+  EXPECT_NE(missing_group.output.find(path("patch.msh") + ": no interface_fault"), std::string::npos) << missing_group.output;
+  const Execution unnamed = run_command(poisson + " --mesh " + changed_file(result, "two.msh", copy_interface_patch));
+  EXPECT_EQ(unnamed.status, 1);
+  EXPECT_NE(unnamed.output.find(path("two.msh") + ": 2 interfaces"), std::string::npos) << unnamed.output;
+  EXPECT_NE(unnamed.output.find("--interface"), std::string::npos) << unnamed.output;
   EXPECT_EQ(run_command(poisson + " --mesh " + path("patch.msh") + " --degree 3").status, 2);
   EXPECT_EQ(run_command(poisson).status, 2);
   EXPECT_EQ(run_command(std::string(SOLVER_DEMO_STUDY) + " --levels 0 --degree 1 --csv x.csv").status, 2);

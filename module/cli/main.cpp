@@ -41,7 +41,7 @@ per cell, refined uniformly by Kossaczky bisection) and inserts immersed surface
 
 Options:
   --box X0,Y0,Z0,X1,Y1,Z1  the box (required)
-  --cells NX,NY,NZ         cell counts (default: equal cells as close to cubes as possible)
+  --cells NX,NY,NZ         cell counts, 1 to 1024 each (default: equal cells as close to cubes as possible)
   --level K                uniform bisection levels: 6·2^K tets per cell (default 0)
   --surface FILE[:NAME]    an open triangulated surface strictly inside the box (.obj, .stl, .off,
                            .msh, .ts GOCAD TSurf); NAME defaults to its 1-based position (may repeat).
@@ -239,14 +239,15 @@ Options parse_options(int argc, char** argv) {
       std::exit(0);
     } else if (arg == "--box") {
       const auto v = parse_numbers(arg, value(), 6);
-      options.box = {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+      options.box = meccano::tools::box_from_numbers<UsageError>(arg, {v[0], v[1], v[2], v[3], v[4], v[5]});
       options.box_given = true;
     } else if (arg == "--cells") {
       const auto v = parse_numbers(arg, value(), 3);
       std::array<int, 3> cells{};
       for (int k = 0; k < 3; ++k) {
+        if (!(v[k] == std::floor(v[k]) && v[k] >= 1 && v[k] <= meccano::max_cells_per_axis))
+          throw UsageError("--cells takes three integers from 1 to " + std::to_string(meccano::max_cells_per_axis));
         cells[k] = static_cast<int>(v[k]);
-        if (cells[k] != v[k] || cells[k] < 1) throw UsageError("--cells takes three positive integers");
       }
       options.cells = cells;
     } else if (arg == "--level") {

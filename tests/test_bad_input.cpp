@@ -160,6 +160,8 @@ TEST_F(BadInput, TheCommandLineRefusesAbsurdSizesAndHonoursMaxTets) {
   EXPECT_NE(output.find("the resolution l_r = 1e-06 would make about"), std::string::npos) << output;
   EXPECT_EQ(shell(cli + "--level 40 --output " + out, output), 1);
   EXPECT_NE(output.find("the meccano mesh (--cells, --level) would make about"), std::string::npos) << output;
+  EXPECT_EQ(shell(cli + "--cells 1024,1024,1024 --level 40 --output " + out, output), 1) << "beyond 64 bits";
+  EXPECT_NE(output.find("the meccano mesh (--cells, --level) would make about"), std::string::npos) << output;
   EXPECT_EQ(shell(cli + "--level 4 --max-tets 95 --output " + out, output), 1) << "6 x 2^4 = 96 tets";
   EXPECT_NE(output.find("above the limit of 95 tets"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(out));

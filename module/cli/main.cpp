@@ -394,7 +394,9 @@ int run(const Options& options) {
   const Progress progress(options.quiet);
   if (options.threads) omp_set_num_threads(*options.threads);
   const auto cells = options.cells ? *options.cells : meccano::cells_for_box(options.box);
-  const std::int64_t expected_tets = (std::int64_t{6} * cells[0] * cells[1] * cells[2]) << options.level;
+  // In floating point: 1024 cells a side at level 40 would overflow 64 bits, and the limit must still refuse it.
+  const double tets = 6.0 * cells[0] * cells[1] * cells[2] * std::ldexp(1.0, options.level);
+  const std::int64_t expected_tets = tets < 0x1p62 ? static_cast<std::int64_t>(tets) : std::int64_t{1} << 62;
   progress.say("meccano: ", cells[0], "x", cells[1], "x", cells[2], " cells, level ", options.level, ", ",
                expected_tets, " tets");
   meccano::check_tet_estimate(expected_tets, options.max_tets, "the meccano mesh (--cells, --level)");

@@ -102,6 +102,11 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+void check_outputs_writable(const CommonOptions& options) {
+  check_writable(options.output);
+  if (options.report) check_writable(*options.report);
+}
+
 std::vector<TriangleSurface> read_valid_surfaces(const CommonOptions& options, const Progress& progress) {
   std::vector<TriangleSurface> surfaces;
   for (const auto& [file, name] : options.surfaces) {

@@ -30,8 +30,9 @@
 // |                                        |                                                      | Refining, BadInput.TheLimitIsOverridable, BadInput.   |
 // |                                        |                                                      | TheCommandLineRefusesAbsurdSizesAndHonoursMaxTets     |
 // | unwritable output path                 | "cannot write /nonexistent-dir/out.msh"              | CliTest.UnwritableOutputFailsWithStatusOne,           |
-// |                                        |                                                      | AFailedWriteRemovesTheFilesTheRunWrote; MeshIo.Failed-|
-// |                                        |                                                      | WriteLeavesNoFile                                     |
+// | (checked before any meshing)           | "cannot write DIR: it is a directory"                | UnwritablePathsFailBeforeMeshing; MeshIo.FailedWrite- |
+// |                                        |                                                      | LeavesNoFile                                          |
+// | write failing midway (several outputs) | "cannot write PATH: File too large"                  | CliTest.AFailedWriteRemovesTheFilesTheRunWrote        |
 // | full disk (no partial file left)       | "cannot write PATH: File too large"                  | BadInput.AFullDiskLeavesNoPartialFile                 |
 
 #include <meccano/cube_meccano.hpp>

@@ -462,20 +462,28 @@ TEST_F(CliTest, WritesEveryFormatInOneRunWithBothInterfaces) {
   EXPECT_EQ(triangles.at(1), sizes.at("xmin"));
 }
 
+// A run whose writes fail past 40 blocks of 512 bytes, as on a full disk: a failure that no check before
+// the run can foresee. At level 6 the .msh and .mesh files take about 10 KB, the .vtu file 39 KB.
+// SIGXFSZ ignored: write() fails instead.
+CliRun run_cli_on_a_small_disk(const std::string& arguments) {
+  return testing::run_command("trap '' XFSZ; ulimit -f 40; exec " + std::string(MECCANO_CLI) + " " + arguments);
+}
+
 TEST_F(CliTest, AFailedWriteRemovesTheFilesTheRunWrote) {
-  const CliRun run = run_cli("--box 0,0,0,1,1,1 --level 1 --output " + path("a.msh") + " --output " + path("a.vtu") +
-                             " --output /nonexistent-dir/out.mesh");
+  const CliRun run = run_cli_on_a_small_disk("--box 0,0,0,1,1,1 --level 6 --output " + path("a.msh") + " --output " +
+                                             path("a.mesh") + " --output " + path("a.vtu"));
   EXPECT_EQ(run.status, 1) << run.output;
-  EXPECT_NE(run.output.find("cannot write /nonexistent-dir/out.mesh"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("cannot write " + path("a.vtu") + ": File too large"), std::string::npos) << run.output;
   EXPECT_TRUE(only_inputs_in_directory(0));
 }
 
 TEST_F(CliTest, AFailedWriteLeavesAFileThatWasThereAsItWas) {
   const std::string earlier = path("a.msh");
   std::ofstream(earlier) << "an earlier result\n";
-  const CliRun run = run_cli("--box 0,0,0,1,1,1 --level 1 --output " + earlier + " --output /nonexistent-dir/out.mesh");
+  const CliRun run =
+      run_cli_on_a_small_disk("--box 0,0,0,1,1,1 --level 6 --output " + earlier + " --output " + path("a.vtu"));
   EXPECT_EQ(run.status, 1) << run.output;
-  EXPECT_NE(run.output.find("cannot write /nonexistent-dir/out.mesh: "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("cannot write " + path("a.vtu") + ": File too large"), std::string::npos) << run.output;
   std::ifstream in(earlier);
   const std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_EQ(content, "an earlier result\n");
@@ -486,6 +494,32 @@ TEST_F(CliTest, UnwritableOutputFailsWithStatusOne) {
   const CliRun run = run_cli("--box 0,0,0,1,1,1 --level 1 --output /nonexistent-dir/out.msh");
   EXPECT_EQ(run.status, 1) << run.output;
   EXPECT_NE(run.output.find("cannot write /nonexistent-dir/out.msh"), std::string::npos) << run.output;
+}
+
+// Every path a run writes is checked before any work: one that cannot be written fails at once, naming
+// it, before the first progress line, and nothing is written.
+TEST_F(CliTest, UnwritablePathsFailBeforeMeshing) {
+  const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
+  ASSERT_EQ(run_cli("--box 0,0,0,1,1,1 --quiet --output " + path("cube.msh")).status, 0);
+  fs::create_directory(path("taken.msh"));
+  const std::string meshing = "--box 0,0,0,1,1,1 --surface " + surface + " --resolution 0.1 --output " + path("ok.msh");
+  const std::map<std::string, std::string> cases{
+      {meshing + " --output /nonexistent-dir/out.vtu",
+       "cannot write /nonexistent-dir/out.vtu: there is no directory /nonexistent-dir"},
+      {meshing + " --report /nonexistent-dir/r.json", "cannot write /nonexistent-dir/r.json: there is no directory"},
+      {meshing + " --histograms /nonexistent-dir/h.csv", "cannot write /nonexistent-dir/h.csv: there is no directory"},
+      {meshing + " --output " + path("taken.msh"), "cannot write " + path("taken.msh") + ": it is a directory"},
+      {"check " + path("cube.msh") + " --report /nonexistent-dir/c.json",
+       "cannot write /nonexistent-dir/c.json: there is no directory"},
+  };
+  for (const auto& [arguments, message] : cases) {
+    const CliRun run = run_cli(arguments);
+    EXPECT_EQ(run.status, 1) << arguments << "\n" << run.output;
+    EXPECT_NE(run.output.find(message), std::string::npos) << arguments << "\n" << run.output;
+    for (const char* work : {"meccano:", "surface 1:", "conformity:"})
+      EXPECT_EQ(run.output.find(work), std::string::npos) << "work began before the check\n" << run.output;
+  }
+  EXPECT_TRUE(only_inputs_in_directory(3));
 }
 
 }  // namespace

@@ -259,6 +259,7 @@ TEST_F(ReferenceTetgenCliTest, AnUnwritableReportLeavesNoMeshEither) {
                                            path("alone.msh") + " --report /nonexistent-dir/alone.json");
   EXPECT_EQ(run.status, 1) << run.output;
   EXPECT_NE(run.output.find("cannot write /nonexistent-dir/alone.json: "), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("tetgen: switches"), std::string::npos) << "checked before meshing\n" << run.output;
   for (const auto& entry : fs::directory_iterator(dir_))
     EXPECT_EQ(entry.path().string().find("alone"), std::string::npos) << "left behind: " << entry.path();
 }

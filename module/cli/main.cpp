@@ -391,6 +391,10 @@ std::vector<meccano::TriangleSurface> read_surfaces(const Options& options, cons
 }
 
 int run(const Options& options) {
+  // Every file the run writes, checked before any work: a mistyped path must not cost a meshing run.
+  for (const auto& output : options.outputs) meccano::check_writable(output.path);
+  for (const auto& path : {options.histograms, options.report})
+    if (path) meccano::check_writable(*path);
   const Progress progress(options.quiet);
   if (options.threads) omp_set_num_threads(*options.threads);
   const auto cells = options.cells ? *options.cells : meccano::cells_for_box(options.box);
@@ -449,7 +453,7 @@ int run(const Options& options) {
 }
 
 // The arguments of the subcommands that read one mesh file: FILE.msh [--report FILE.json] [--quiet], and
-// --surface FILE[:NAME] ... for those that take surfaces.
+// --surface FILE[:NAME] ... for those that take surfaces. The report's path is checked writable here.
 struct FileCommand {
   std::string file;
   std::optional<std::string> report;
@@ -483,6 +487,7 @@ FileCommand parse_file_command(const std::string& command, const std::vector<std
     }
   }
   if (parsed.file.empty()) throw UsageError(command + " needs a mesh file: meccano-immerse " + command + " FILE.msh");
+  if (parsed.report) meccano::check_writable(*parsed.report);  // before the mesh file is read
   return parsed;
 }
 

@@ -184,6 +184,28 @@ TEST_F(CliTest, ProgressReportsEachStageWithCounts) {
   EXPECT_NE(run.output.find("wrote"), std::string::npos) << run.output;
 }
 
+// SUS can run for minutes after the projection's line: every sweep says how far it got, and --quiet
+// silences these lines with the others.
+TEST_F(CliTest, EverySmoothingSweepHasAProgressLine) {
+  const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
+  const std::string arguments = "--box 0,0,0,1,1,1 --surface " + surface + " --resolution 0.1 --output " + path("mesh.msh");
+  const CliRun run = run_cli(arguments);
+  ASSERT_EQ(run.status, 0) << run.output;
+  // The stage's line counts the sweeps: "smoothing: ... inverted tets before, M after N sweeps (...".
+  const std::size_t summary = run.output.find("smoothing: ");
+  ASSERT_NE(summary, std::string::npos) << run.output;
+  const int sweeps = std::stoi(run.output.substr(run.output.find(" after ", summary) + 7));
+  ASSERT_GT(sweeps, 0) << run.output;
+  for (int sweep = 1; sweep <= sweeps; ++sweep)
+    EXPECT_NE(run.output.find("smoothing sweep " + std::to_string(sweep) + ": "), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("smoothing sweep " + std::to_string(sweeps + 1) + ": "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(" tets inverted, quality min "), std::string::npos) << run.output;
+
+  const CliRun quiet = run_cli(arguments + " --quiet");
+  ASSERT_EQ(quiet.status, 0) << quiet.output;
+  EXPECT_TRUE(quiet.output.empty()) << "--quiet printed: " << quiet.output;
+}
+
 TEST_F(CliTest, VolumetricStageWritesOneGroupPerSurface) {
   const auto [lower, upper] = write_stacked_pair();
   const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + lower + " --surface " + upper +

@@ -420,7 +420,8 @@ int run(const Options& options) {
   insertion.smoothing = options.smoothing;
   insertion.max_tets = options.max_tets;
   insertion.finer_retries = options.finer_retries;
-  insertion.progress = [&progress](const std::string& line) { progress.say(line); };
+  // Without a callback the stages build no progress lines at all.
+  if (!options.quiet) insertion.progress = [&progress](const std::string& line) { progress.say(line); };
   const meccano::InsertionResult result = meccano::insert_surfaces(std::move(mesh), surfaces, insertion);
 
   // A tangled mesh is written only as the projection stage's inspection output.

@@ -157,7 +157,16 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
   const auto start = std::chrono::steady_clock::now();
   std::vector<SurfaceProjection*> projections;
   for (SurfaceInsertion& inserted : result.surfaces) projections.push_back(&inserted.projection);
-  result.smoothing = smooth_mesh(result.mesh, projections, options.smoothing);
+  SmoothingOptions smoothing_options = options.smoothing;
+  if (options.progress)
+    smoothing_options.on_sweep = [&options, caller_on_sweep = options.smoothing.on_sweep](int sweep, const SweepRecord& record) {
+      if (caller_on_sweep) caller_on_sweep(sweep, record);
+      report(options, "smoothing sweep ", sweep, ": ", record.inverted, " tets inverted, quality min ", record.min_quality,
+             " mean ", record.mean_quality,
+             record.target == SmoothingTarget::equilateral ? " towards the equilateral target" : "", ", ",
+             record.nodes_optimised, " nodes optimised");
+    };
+  result.smoothing = smooth_mesh(result.mesh, projections, smoothing_options);
   result.smoothing_seconds = seconds_since(start);
   const SmoothingStats& smoothing = result.smoothing;
   const SweepRecord last = smoothing.sweeps.empty() ? SweepRecord{} : smoothing.sweeps.back();

@@ -315,6 +315,45 @@ TEST_F(CliTest, FullPipelineWritesAnUntangledMeshAReportAndHistograms) {
                     "after_smoothing_equilateral");
 }
 
+// An insertion that fails after its retries (one sweep cannot untangle the projected patch, on either
+// side, at l_r and at l_r / 2) lists each attempt on one line, with its l_r and side rule, and says once
+// what the failure means and what may mend it.
+TEST_F(CliTest, AFailureAfterRetriesListsEachAttemptOnOneLine) {
+  const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + surface + " --resolution 0.1 --max-sweeps 1 " +
+                             "--fallback-sweeps 0 --finer-retries 1 --quiet --output " + path("mesh.msh"));
+  EXPECT_EQ(run.status, 1) << run.output;
+  std::vector<std::string> lines;
+  std::istringstream text(run.output);
+  for (std::string line; std::getline(text, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 6u) << run.output;
+  EXPECT_EQ(lines[0], "meccano-immerse: error: the insertion failed (4 attempts):");
+  const std::array<const char*, 4> settings{"l_r = 0.1, side positive", "l_r = 0.1, side negative-only",
+                                            "l_r = 0.05, side positive", "l_r = 0.05, side negative-only"};
+  for (std::size_t k = 0; k < settings.size(); ++k) {
+    const std::string& line = lines[k + 1];
+    EXPECT_TRUE(line.starts_with("  attempt " + std::to_string(k + 1) + " (" + settings[k] + "): ")) << line;
+    EXPECT_TRUE(line.ends_with(" tets are still inverted after 1 sweeps")) << line;
+  }
+  EXPECT_EQ(lines[5], "smoothing could not untangle the mesh; more finer retries (--finer-retries, "
+                      "InsertionOptions::finer_retries; 1 here) may succeed");
+
+  // A flat patch below it that projection leaves untangled: only the first patch changes sides and is
+  // retried finer, and the settings name each surface's.
+  const std::string flat =
+      write_obj("flat.obj", testing::graph_patch([](double, double) { return 0.2; }, {0.3, 0.7}, {0.3, 0.7}, 4));
+  const CliRun two = run_cli("--box 0,0,0,1,1,1 --surface " + surface + ":patch --surface " + flat +
+                             ":flat --resolution 0.1 --max-sweeps 1 --fallback-sweeps 0 --finer-retries 1 --quiet " +
+                             "--output " + path("mesh.msh"));
+  EXPECT_EQ(two.status, 1) << two.output;
+  for (const char* line : {"\n  attempt 1 (l_r = 0.1, side positive): ",
+                           "\n  attempt 2 (l_r = 0.1, side patch negative-only, flat positive): ",
+                           "\n  attempt 3 (l_r = patch 0.05, flat 0.1, side positive): ",
+                           "\n  attempt 4 (l_r = patch 0.05, flat 0.1, side patch negative-only, flat positive): "})
+    EXPECT_NE(two.output.find(line), std::string::npos) << line << "\n" << two.output;
+  EXPECT_TRUE(only_inputs_in_directory(2));
+}
+
 TEST_F(CliTest, BadSurfacesFailWithTheirOwnMessageAndWriteNothing) {
   const TriangleSurface patch = testing::paper_like_patch(6);
   TriangleSurface outside = patch;

@@ -106,7 +106,8 @@ TEST_F(CliTest, HelpExitsZeroWithExamples) {
   EXPECT_NE(run.output.find("--box X0,Y0,Z0,X1,Y1,Z1"), std::string::npos);
   EXPECT_NE(run.output.find("Examples:"), std::string::npos);
   for (const char* text : {"--msh-version V", ".vtu", ".mesh", "--output fault.vtu", ".ts GOCAD TSurf", "ZPOSITIVE",
-                           "--weld-tolerance D", "--split-parts"})
+                           "--weld-tolerance D", "--split-parts", "the tets far from the surfaces", "1.26·h·2^(-K/3)",
+                           "A solver's accuracy away from"})
     EXPECT_NE(run.output.find(text), std::string::npos) << text;
 }
 

@@ -41,8 +41,13 @@ per cell, refined uniformly by Kossaczky bisection) and inserts immersed surface
 
 Options:
   --box X0,Y0,Z0,X1,Y1,Z1  the box (required)
-  --cells NX,NY,NZ         cell counts, 1 to 1024 each (default: equal cells as close to cubes as possible)
-  --level K                uniform bisection levels: 6·2^K tets per cell (default 0)
+  --cells NX,NY,NZ         cell counts, 1 to 1024 each (default: equal cells as close to cubes as
+                           possible)
+  --level K                uniform bisection levels: 6·2^K tets per cell (default 0). K sets the size of
+                           the tets far from the surfaces, which --resolution leaves alone: edges of about
+                           1.26·h·2^(-K/3) on average (the longest √3·h/2^k at K = 3k), h the cell edge
+                           (by default about the box's shortest extent). A solver's accuracy away from
+                           the surfaces depends on K: the default leaves 6 tets per cell there
   --surface FILE[:NAME]    an open triangulated surface strictly inside the box (.obj, .stl, .off,
                            .msh, .ts GOCAD TSurf); NAME defaults to its 1-based position (may repeat).
                            Coordinates are taken as in the file: a TSurf's z is its own (a ZPOSITIVE

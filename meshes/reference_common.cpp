@@ -26,9 +26,7 @@ Box parse_box(const std::vector<std::string>& args, std::size_t& i) {
   if (items.size() != 6) throw UsageError(option + " takes 6 numbers: XMIN YMIN ZMIN XMAX YMAX ZMAX");
   std::array<double, 6> v{};
   for (int k = 0; k < 6; ++k) v[k] = parse_number(option, items[k]);
-  for (int k = 0; k < 3; ++k)
-    if (!(v[k] < v[k + 3])) throw UsageError(option + ": every minimum must be below its maximum");
-  return {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+  return tools::box_from_numbers<UsageError>(option, v);
 }
 
 bool ends_with(const std::string& text, const std::string& suffix) {
@@ -102,6 +100,11 @@ void parse_arguments(int argc, char** argv, const char* usage_text, CommonOption
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void check_outputs_writable(const CommonOptions& options) {
+  check_writable(options.output);
+  if (options.report) check_writable(*options.report);
 }
 
 std::vector<TriangleSurface> read_valid_surfaces(const CommonOptions& options, const Progress& progress) {

@@ -74,6 +74,10 @@ double seconds_since(Clock::time_point start);
 
 using tools::Progress;
 
+// Throws InputError naming the first of --output and --report that cannot be written (check_writable);
+// a tool calls it before meshing.
+void check_outputs_writable(const CommonOptions& options);
+
 // The surfaces of the options, named, in order, validated against the box.
 std::vector<TriangleSurface> read_valid_surfaces(const CommonOptions& options, const Progress& progress);
 

@@ -322,6 +322,7 @@ int run(const Options& options) {
   const auto start = Clock::now();
   const meccano::reference::CommonOptions& common = options.common;
   const meccano::reference::Progress progress(common.quiet);
+  meccano::reference::check_outputs_writable(common);
   // Every surface is read and validated before TetGen starts: the same inputs as meccano-immerse, with
   // the same messages, and no TetGen failure for what meccano-immerse would reject.
   const std::vector<meccano::TriangleSurface> surfaces = meccano::reference::read_valid_surfaces(common, progress);

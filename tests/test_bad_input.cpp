@@ -30,8 +30,9 @@
 // |                                        |                                                      | Refining, BadInput.TheLimitIsOverridable, BadInput.   |
 // |                                        |                                                      | TheCommandLineRefusesAbsurdSizesAndHonoursMaxTets     |
 // | unwritable output path                 | "cannot write /nonexistent-dir/out.msh"              | CliTest.UnwritableOutputFailsWithStatusOne,           |
-// |                                        |                                                      | AFailedWriteRemovesTheFilesTheRunWrote; MeshIo.Failed-|
-// |                                        |                                                      | WriteLeavesNoFile                                     |
+// | (checked before any meshing)           | "cannot write DIR: it is a directory"                | UnwritablePathsFailBeforeMeshing; MeshIo.FailedWrite- |
+// |                                        |                                                      | LeavesNoFile                                          |
+// | write failing midway (several outputs) | "cannot write PATH: File too large"                  | CliTest.AFailedWriteRemovesTheFilesTheRunWrote        |
 // | full disk (no partial file left)       | "cannot write PATH: File too large"                  | BadInput.AFullDiskLeavesNoPartialFile                 |
 
 #include <meccano/cube_meccano.hpp>
@@ -159,6 +160,8 @@ TEST_F(BadInput, TheCommandLineRefusesAbsurdSizesAndHonoursMaxTets) {
   EXPECT_EQ(shell(cli + "--surface " + (dir_ / "patch.obj").string() + " --resolution 1e-6 --output " + out, output), 1);
   EXPECT_NE(output.find("the resolution l_r = 1e-06 would make about"), std::string::npos) << output;
   EXPECT_EQ(shell(cli + "--level 40 --output " + out, output), 1);
+  EXPECT_NE(output.find("the meccano mesh (--cells, --level) would make about"), std::string::npos) << output;
+  EXPECT_EQ(shell(cli + "--cells 1024,1024,1024 --level 40 --output " + out, output), 1) << "beyond 64 bits";
   EXPECT_NE(output.find("the meccano mesh (--cells, --level) would make about"), std::string::npos) << output;
   EXPECT_EQ(shell(cli + "--level 4 --max-tets 95 --output " + out, output), 1) << "6 x 2^4 = 96 tets";
   EXPECT_NE(output.find("above the limit of 95 tets"), std::string::npos) << output;

@@ -102,7 +102,8 @@ TEST_F(CliTest, HelpExitsZeroWithExamples) {
   EXPECT_NE(run.output.find("--box X0,Y0,Z0,X1,Y1,Z1"), std::string::npos);
   EXPECT_NE(run.output.find("Examples:"), std::string::npos);
   for (const char* text : {"--msh-version V", ".vtu", ".mesh", "--output fault.vtu", ".ts GOCAD TSurf", "ZPOSITIVE",
-                           "--weld-tolerance D", "--split-parts"})
+                           "--weld-tolerance D", "--split-parts", "the tets far from the surfaces", "1.26·h·2^(-K/3)",
+                           "A solver's accuracy away from"})
     EXPECT_NE(run.output.find(text), std::string::npos) << text;
 }
 
@@ -112,6 +113,12 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
       {"--box 0,0,0,1,1,1", "--output is required"},
       {"--box 0,0,0,1,1 --output " + path("a.msh"), "takes 6 comma-separated numbers"},
       {"--box 0,0,0,1,x,1 --output " + path("a.msh"), "is not a finite number"},
+      {"--box 1,1,1,0,0,0 --output " + path("a.msh"), "--box: on axis x the minimum 1 must be below the maximum 0"},
+      {"--box 0,0,0,1,0,1 --output " + path("a.msh"), "--box: on axis y the minimum 0 must be below the maximum 0"},
+      {"--box -1e308,0,0,1e308,1,1 --output " + path("a.msh"), "below the maximum 1e+308 by a finite extent"},
+      {"--box 0,0,0,1,1,1 --cells 2,0,2 --output " + path("a.msh"), "--cells takes three integers from 1 to 1024"},
+      {"--box 0,0,0,1,1,1 --cells 2000,1,1 --output " + path("a.msh"), "--cells takes three integers from 1 to 1024"},
+      {"--box 0,0,0,1,1,1 --cells 1e10,1,1 --output " + path("a.msh"), "--cells takes three integers from 1 to 1024"},
       {"--box 0,0,0,1,1,1 --level -1 --output " + path("a.msh"), "--level must be between"},
       {"--box 0,0,0,1,1,1 --frobnicate --output " + path("a.msh"), "unknown option"},
       {"--box 0,0,0,1,1,1 --output " + path("a.vtk"), "unknown format; the extensions are .msh"},
@@ -172,6 +179,28 @@ TEST_F(CliTest, ProgressReportsEachStageWithCounts) {
   EXPECT_NE(run.output.find("surface patch:"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("volumetric patch:"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("wrote"), std::string::npos) << run.output;
+}
+
+// SUS can run for minutes after the projection's line: every sweep says how far it got, and --quiet
+// silences these lines with the others.
+TEST_F(CliTest, EverySmoothingSweepHasAProgressLine) {
+  const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
+  const std::string arguments = "--box 0,0,0,1,1,1 --surface " + surface + " --resolution 0.1 --output " + path("mesh.msh");
+  const CliRun run = run_cli(arguments);
+  ASSERT_EQ(run.status, 0) << run.output;
+  // The stage's line counts the sweeps: "smoothing: ... inverted tets before, M after N sweeps (...".
+  const std::size_t summary = run.output.find("smoothing: ");
+  ASSERT_NE(summary, std::string::npos) << run.output;
+  const int sweeps = std::stoi(run.output.substr(run.output.find(" after ", summary) + 7));
+  ASSERT_GT(sweeps, 0) << run.output;
+  for (int sweep = 1; sweep <= sweeps; ++sweep)
+    EXPECT_NE(run.output.find("smoothing sweep " + std::to_string(sweep) + ": "), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("smoothing sweep " + std::to_string(sweeps + 1) + ": "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(" tets inverted, quality min "), std::string::npos) << run.output;
+
+  const CliRun quiet = run_cli(arguments + " --quiet");
+  ASSERT_EQ(quiet.status, 0) << quiet.output;
+  EXPECT_TRUE(quiet.output.empty()) << "--quiet printed: " << quiet.output;
 }
 
 TEST_F(CliTest, VolumetricStageWritesOneGroupPerSurface) {
@@ -281,6 +310,45 @@ TEST_F(CliTest, FullPipelineWritesAnUntangledMeshAReportAndHistograms) {
   std::getline(histogram_file, header);
   EXPECT_EQ(header, "bin_low,bin_high,before_smoothing_meccano,before_smoothing_equilateral,after_smoothing_meccano,"
                     "after_smoothing_equilateral");
+}
+
+// An insertion that fails after its retries (one sweep cannot untangle the projected patch, on either
+// side, at l_r and at l_r / 2) lists each attempt on one line, with its l_r and side rule, and says once
+// what the failure means and what may mend it.
+TEST_F(CliTest, AFailureAfterRetriesListsEachAttemptOnOneLine) {
+  const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + surface + " --resolution 0.1 --max-sweeps 1 " +
+                             "--fallback-sweeps 0 --finer-retries 1 --quiet --output " + path("mesh.msh"));
+  EXPECT_EQ(run.status, 1) << run.output;
+  std::vector<std::string> lines;
+  std::istringstream text(run.output);
+  for (std::string line; std::getline(text, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 6u) << run.output;
+  EXPECT_EQ(lines[0], "meccano-immerse: error: the insertion failed (4 attempts):");
+  const std::array<const char*, 4> settings{"l_r = 0.1, side positive", "l_r = 0.1, side negative-only",
+                                            "l_r = 0.05, side positive", "l_r = 0.05, side negative-only"};
+  for (std::size_t k = 0; k < settings.size(); ++k) {
+    const std::string& line = lines[k + 1];
+    EXPECT_TRUE(line.starts_with("  attempt " + std::to_string(k + 1) + " (" + settings[k] + "): ")) << line;
+    EXPECT_TRUE(line.ends_with(" tets are still inverted after 1 sweeps")) << line;
+  }
+  EXPECT_EQ(lines[5], "smoothing could not untangle the mesh; more finer retries (--finer-retries, "
+                      "InsertionOptions::finer_retries; 1 here) may succeed");
+
+  // A flat patch below it that projection leaves untangled: only the first patch changes sides and is
+  // retried finer, and the settings name each surface's.
+  const std::string flat =
+      write_obj("flat.obj", testing::graph_patch([](double, double) { return 0.2; }, {0.3, 0.7}, {0.3, 0.7}, 4));
+  const CliRun two = run_cli("--box 0,0,0,1,1,1 --surface " + surface + ":patch --surface " + flat +
+                             ":flat --resolution 0.1 --max-sweeps 1 --fallback-sweeps 0 --finer-retries 1 --quiet " +
+                             "--output " + path("mesh.msh"));
+  EXPECT_EQ(two.status, 1) << two.output;
+  for (const char* line : {"\n  attempt 1 (l_r = 0.1, side positive): ",
+                           "\n  attempt 2 (l_r = 0.1, side patch negative-only, flat positive): ",
+                           "\n  attempt 3 (l_r = patch 0.05, flat 0.1, side positive): ",
+                           "\n  attempt 4 (l_r = patch 0.05, flat 0.1, side patch negative-only, flat positive): "})
+    EXPECT_NE(two.output.find(line), std::string::npos) << line << "\n" << two.output;
+  EXPECT_TRUE(only_inputs_in_directory(2));
 }
 
 TEST_F(CliTest, BadSurfacesFailWithTheirOwnMessageAndWriteNothing) {
@@ -456,20 +524,28 @@ TEST_F(CliTest, WritesEveryFormatInOneRunWithBothInterfaces) {
   EXPECT_EQ(triangles.at(1), sizes.at("xmin"));
 }
 
+// A run whose writes fail past 40 blocks of 512 bytes, as on a full disk: a failure that no check before
+// the run can foresee. At level 6 the .msh and .mesh files take about 10 KB, the .vtu file 39 KB.
+// SIGXFSZ ignored: write() fails instead.
+CliRun run_cli_on_a_small_disk(const std::string& arguments) {
+  return testing::run_command("trap '' XFSZ; ulimit -f 40; exec " + std::string(MECCANO_CLI) + " " + arguments);
+}
+
 TEST_F(CliTest, AFailedWriteRemovesTheFilesTheRunWrote) {
-  const CliRun run = run_cli("--box 0,0,0,1,1,1 --level 1 --output " + path("a.msh") + " --output " + path("a.vtu") +
-                             " --output /nonexistent-dir/out.mesh");
+  const CliRun run = run_cli_on_a_small_disk("--box 0,0,0,1,1,1 --level 6 --output " + path("a.msh") + " --output " +
+                                             path("a.mesh") + " --output " + path("a.vtu"));
   EXPECT_EQ(run.status, 1) << run.output;
-  EXPECT_NE(run.output.find("cannot write /nonexistent-dir/out.mesh"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("cannot write " + path("a.vtu") + ": File too large"), std::string::npos) << run.output;
   EXPECT_TRUE(only_inputs_in_directory(0));
 }
 
 TEST_F(CliTest, AFailedWriteLeavesAFileThatWasThereAsItWas) {
   const std::string earlier = path("a.msh");
   std::ofstream(earlier) << "an earlier result\n";
-  const CliRun run = run_cli("--box 0,0,0,1,1,1 --level 1 --output " + earlier + " --output /nonexistent-dir/out.mesh");
+  const CliRun run =
+      run_cli_on_a_small_disk("--box 0,0,0,1,1,1 --level 6 --output " + earlier + " --output " + path("a.vtu"));
   EXPECT_EQ(run.status, 1) << run.output;
-  EXPECT_NE(run.output.find("cannot write /nonexistent-dir/out.mesh: "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("cannot write " + path("a.vtu") + ": File too large"), std::string::npos) << run.output;
   std::ifstream in(earlier);
   const std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_EQ(content, "an earlier result\n");
@@ -480,6 +556,32 @@ TEST_F(CliTest, UnwritableOutputFailsWithStatusOne) {
   const CliRun run = run_cli("--box 0,0,0,1,1,1 --level 1 --output /nonexistent-dir/out.msh");
   EXPECT_EQ(run.status, 1) << run.output;
   EXPECT_NE(run.output.find("cannot write /nonexistent-dir/out.msh"), std::string::npos) << run.output;
+}
+
+// Every path a run writes is checked before any work: one that cannot be written fails at once, naming
+// it, before the first progress line, and nothing is written.
+TEST_F(CliTest, UnwritablePathsFailBeforeMeshing) {
+  const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
+  ASSERT_EQ(run_cli("--box 0,0,0,1,1,1 --quiet --output " + path("cube.msh")).status, 0);
+  fs::create_directory(path("taken.msh"));
+  const std::string meshing = "--box 0,0,0,1,1,1 --surface " + surface + " --resolution 0.1 --output " + path("ok.msh");
+  const std::map<std::string, std::string> cases{
+      {meshing + " --output /nonexistent-dir/out.vtu",
+       "cannot write /nonexistent-dir/out.vtu: there is no directory /nonexistent-dir"},
+      {meshing + " --report /nonexistent-dir/r.json", "cannot write /nonexistent-dir/r.json: there is no directory"},
+      {meshing + " --histograms /nonexistent-dir/h.csv", "cannot write /nonexistent-dir/h.csv: there is no directory"},
+      {meshing + " --output " + path("taken.msh"), "cannot write " + path("taken.msh") + ": it is a directory"},
+      {"check " + path("cube.msh") + " --report /nonexistent-dir/c.json",
+       "cannot write /nonexistent-dir/c.json: there is no directory"},
+  };
+  for (const auto& [arguments, message] : cases) {
+    const CliRun run = run_cli(arguments);
+    EXPECT_EQ(run.status, 1) << arguments << "\n" << run.output;
+    EXPECT_NE(run.output.find(message), std::string::npos) << arguments << "\n" << run.output;
+    for (const char* work : {"meccano:", "surface 1:", "conformity:"})
+      EXPECT_EQ(run.output.find(work), std::string::npos) << "work began before the check\n" << run.output;
+  }
+  EXPECT_TRUE(only_inputs_in_directory(3));
 }
 
 }  // namespace

@@ -253,6 +253,7 @@ TEST_F(ReferenceTetgenCliTest, AnUnwritableReportLeavesNoMeshEither) {
                                            path("alone.msh") + " --report /nonexistent-dir/alone.json");
   EXPECT_EQ(run.status, 1) << run.output;
   EXPECT_NE(run.output.find("cannot write /nonexistent-dir/alone.json: "), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("tetgen: switches"), std::string::npos) << "checked before meshing\n" << run.output;
   for (const auto& entry : fs::directory_iterator(dir_))
     EXPECT_EQ(entry.path().string().find("alone"), std::string::npos) << "left behind: " << entry.path();
 }
@@ -263,6 +264,8 @@ TEST_F(ReferenceTetgenCliTest, UsageErrorsExitTwoWithAMessage) {
   const std::map<std::string, std::string> cases{
       {"--surface a.obj --size 0.1" + rest, "--box is required"},
       {"--box 0 0 0 1 1 --surface a.obj --size 0.1" + rest, "--box takes 6 numbers"},
+      {"--box 0 1 0 1 0 1 --surface a.obj --size 0.1" + rest, "--box: on axis y the minimum 1 must be below the maximum 0"},
+      {"--box -1e308 0 0 1e308 1 1 --surface a.obj --size 0.1" + rest, "by a finite extent"},
       {"--box 0 0 0 1 1 1 --surface a.obj" + rest, "--size is required"},
       {valid + " --radius-edge 0.9" + rest, "--radius-edge must be at least 1"},
       {valid + " --radius-edge" + rest, "is not a finite number"},

@@ -41,8 +41,13 @@ per cell, refined uniformly by Kossaczky bisection) and inserts immersed surface
 
 Options:
   --box X0,Y0,Z0,X1,Y1,Z1  the box (required)
-  --cells NX,NY,NZ         cell counts (default: equal cells as close to cubes as possible)
-  --level K                uniform bisection levels: 6·2^K tets per cell (default 0)
+  --cells NX,NY,NZ         cell counts, 1 to 1024 each (default: equal cells as close to cubes as
+                           possible)
+  --level K                uniform bisection levels: 6·2^K tets per cell (default 0). K sets the size of
+                           the tets far from the surfaces, which --resolution leaves alone: edges of about
+                           1.26·h·2^(-K/3) on average (the longest √3·h/2^k at K = 3k), h the cell edge
+                           (by default about the box's shortest extent). A solver's accuracy away from
+                           the surfaces depends on K: the default leaves 6 tets per cell there
   --surface FILE[:NAME]    an open triangulated surface strictly inside the box (.obj, .stl, .off,
                            .msh, .ts GOCAD TSurf); NAME defaults to its 1-based position (may repeat).
                            Coordinates are taken as in the file: a TSurf's z is its own (a ZPOSITIVE
@@ -239,14 +244,15 @@ Options parse_options(int argc, char** argv) {
       std::exit(0);
     } else if (arg == "--box") {
       const auto v = parse_numbers(arg, value(), 6);
-      options.box = {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+      options.box = meccano::tools::box_from_numbers<UsageError>(arg, {v[0], v[1], v[2], v[3], v[4], v[5]});
       options.box_given = true;
     } else if (arg == "--cells") {
       const auto v = parse_numbers(arg, value(), 3);
       std::array<int, 3> cells{};
       for (int k = 0; k < 3; ++k) {
+        if (!(v[k] == std::floor(v[k]) && v[k] >= 1 && v[k] <= meccano::max_cells_per_axis))
+          throw UsageError("--cells takes three integers from 1 to " + std::to_string(meccano::max_cells_per_axis));
         cells[k] = static_cast<int>(v[k]);
-        if (cells[k] != v[k] || cells[k] < 1) throw UsageError("--cells takes three positive integers");
       }
       options.cells = cells;
     } else if (arg == "--level") {
@@ -390,10 +396,16 @@ std::vector<meccano::TriangleSurface> read_surfaces(const Options& options, cons
 }
 
 int run(const Options& options) {
+  // Every file the run writes, checked before any work: a mistyped path must not cost a meshing run.
+  for (const auto& output : options.outputs) meccano::check_writable(output.path);
+  for (const auto& path : {options.histograms, options.report})
+    if (path) meccano::check_writable(*path);
   const Progress progress(options.quiet);
   if (options.threads) omp_set_num_threads(*options.threads);
   const auto cells = options.cells ? *options.cells : meccano::cells_for_box(options.box);
-  const std::int64_t expected_tets = (std::int64_t{6} * cells[0] * cells[1] * cells[2]) << options.level;
+  // In floating point: 1024 cells a side at level 40 would overflow 64 bits, and the limit must still refuse it.
+  const double tets = 6.0 * cells[0] * cells[1] * cells[2] * std::ldexp(1.0, options.level);
+  const std::int64_t expected_tets = tets < 0x1p62 ? static_cast<std::int64_t>(tets) : std::int64_t{1} << 62;
   progress.say("meccano: ", cells[0], "x", cells[1], "x", cells[2], " cells, level ", options.level, ", ",
                expected_tets, " tets");
   meccano::check_tet_estimate(expected_tets, options.max_tets, "the meccano mesh (--cells, --level)");
@@ -413,7 +425,8 @@ int run(const Options& options) {
   insertion.smoothing = options.smoothing;
   insertion.max_tets = options.max_tets;
   insertion.finer_retries = options.finer_retries;
-  insertion.progress = [&progress](const std::string& line) { progress.say(line); };
+  // Without a callback the stages build no progress lines at all.
+  if (!options.quiet) insertion.progress = [&progress](const std::string& line) { progress.say(line); };
   const meccano::InsertionResult result = meccano::insert_surfaces(std::move(mesh), surfaces, insertion);
 
   // A tangled mesh is written only as the projection stage's inspection output.
@@ -446,7 +459,7 @@ int run(const Options& options) {
 }
 
 // The arguments of the subcommands that read one mesh file: FILE.msh [--report FILE.json] [--quiet], and
-// --surface FILE[:NAME] ... for those that take surfaces.
+// --surface FILE[:NAME] ... for those that take surfaces. The report's path is checked writable here.
 struct FileCommand {
   std::string file;
   std::optional<std::string> report;
@@ -480,6 +493,7 @@ FileCommand parse_file_command(const std::string& command, const std::vector<std
     }
   }
   if (parsed.file.empty()) throw UsageError(command + " needs a mesh file: meccano-immerse " + command + " FILE.msh");
+  if (parsed.report) meccano::check_writable(*parsed.report);  // before the mesh file is read
   return parsed;
 }
 

@@ -1,8 +1,11 @@
 // What the project's command-line tools share (meccano-immerse, and reference-gmsh and reference-tetgen
-// in meshes/): number arguments, the FILE[:NAME] surface argument and timestamped progress lines. Header-only; not part
-// of the installed library.
+// in meshes/): number arguments, the box, the FILE[:NAME] surface argument and timestamped progress lines. Header-only;
+// not part of the installed library.
 #pragma once
 
+#include <meccano/box.hpp>
+
+#include <array>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -27,6 +30,20 @@ double parse_finite_number(const std::string& option, const std::string& text) {
   if (used == 0 || used != text.size() || !std::isfinite(value))
     throw Error(option + ": '" + text + "' is not a finite number");
   return value;
+}
+
+// The box of six numbers, the minimum corner first. A box the meccano cannot fill (a minimum not below its
+// maximum, or an extent too large for a double) is a malformed option: Error (the tool's usage error)
+// naming the option and the axis.
+template <class Error>
+Box box_from_numbers(const std::string& option, const std::array<double, 6>& v) {
+  for (int k = 0; k < 3; ++k) {
+    std::ostringstream message;
+    message << option << ": on axis " << "xyz"[k] << " the minimum " << v[k] << " must be below the maximum " << v[k + 3];
+    if (!(v[k] < v[k + 3])) throw Error(message.str());
+    if (!std::isfinite(v[k + 3] - v[k])) throw Error(message.str() + " by a finite extent");
+  }
+  return {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
 }
 
 // FILE[:NAME] as (file, name), NAME defaulting to the surface's 1-based position. A colon followed by a

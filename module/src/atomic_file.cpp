@@ -70,6 +70,19 @@ void write_file_atomically(const std::string& path, const std::function<void(std
   if (error) fail(error.message());
 }
 
+void check_writable(const std::string& path) {
+  std::error_code status_error;
+  if (fs::is_directory(fs::path(path), status_error)) throw InputError("cannot write " + path + ": it is a directory");
+  require_regular_or_absent(path);
+  const fs::path parent = fs::path(path).parent_path();
+  const fs::path directory = parent.empty() ? fs::path(".") : parent;
+  if (!fs::is_directory(directory, status_error))
+    throw InputError("cannot write " + path + ": there is no directory " + directory.string());
+  // Writing creates a temporary beside the target and renames it: the directory must be writable.
+  if (::access(directory.c_str(), W_OK | X_OK) != 0)
+    throw InputError("cannot write " + path + ": " + directory.string() + ": " + std::strerror(errno));
+}
+
 StagedFiles::~StagedFiles() {
   for (const auto& [staged, target] : staged_) {
     std::error_code ignored;

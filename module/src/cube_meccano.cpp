@@ -12,10 +12,10 @@ namespace {
 
 void check_box(const Box& box) {
   for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(box.min[k]) || !std::isfinite(box.max[k]) || !(box.min[k] < box.max[k])) {
+    if (!std::isfinite(box.max[k] - box.min[k]) || !(box.min[k] < box.max[k])) {
       std::ostringstream message;
       message << "invalid box: on axis " << "xyz"[k] << " the lower bound " << box.min[k]
-              << " is not below the upper bound " << box.max[k];
+              << " is not below the upper bound " << box.max[k] << " by a finite extent";
       throw InputError(message.str());
     }
 }
@@ -51,9 +51,9 @@ std::array<int, 3> cells_for_box(const Box& box) {
 TetMesh make_cube_meccano(const Box& box, const std::array<int, 3>& cells, int level) {
   check_box(box);
   for (int k = 0; k < 3; ++k)
-    if (cells[k] < 1 || cells[k] > 1024)
+    if (cells[k] < 1 || cells[k] > max_cells_per_axis)
       throw InputError("invalid cell count " + std::to_string(cells[k]) + " on axis " + "xyz"[k] +
-                       " (allowed: 1 to 1024)");
+                       " (allowed: 1 to " + std::to_string(max_cells_per_axis) + ")");
   if (level < 0) throw InputError("invalid level " + std::to_string(level) + " (must be 0 or more)");
 
   TetMesh mesh;

@@ -157,7 +157,16 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
   const auto start = std::chrono::steady_clock::now();
   std::vector<SurfaceProjection*> projections;
   for (SurfaceInsertion& inserted : result.surfaces) projections.push_back(&inserted.projection);
-  result.smoothing = smooth_mesh(result.mesh, projections, options.smoothing);
+  SmoothingOptions smoothing_options = options.smoothing;
+  if (options.progress)
+    smoothing_options.on_sweep = [&options, caller_on_sweep = options.smoothing.on_sweep](int sweep, const SweepRecord& record) {
+      if (caller_on_sweep) caller_on_sweep(sweep, record);
+      report(options, "smoothing sweep ", sweep, ": ", record.inverted, " tets inverted, quality min ", record.min_quality,
+             " mean ", record.mean_quality,
+             record.target == SmoothingTarget::equilateral ? " towards the equilateral target" : "", ", ",
+             record.nodes_optimised, " nodes optimised");
+    };
+  result.smoothing = smooth_mesh(result.mesh, projections, smoothing_options);
   result.smoothing_seconds = seconds_since(start);
   const SmoothingStats& smoothing = result.smoothing;
   const SweepRecord last = smoothing.sweeps.empty() ? SweepRecord{} : smoothing.sweeps.back();
@@ -190,11 +199,80 @@ class ThreadCount {
   int previous_;
 };
 
-std::string untangling_failure(const InsertionResult& result, const InsertionOptions& options) {
-  return "smoothing could not untangle the mesh: " + std::to_string(result.smoothing.inverted_after) +
-         " tets are still inverted after " + std::to_string(result.smoothing.sweeps.size()) +
-         " sweeps; try a smaller resolution" +
-         (options.smoothing.mode == SmoothingMode::band ? " or the whole-mesh mode" : "");
+std::string tets_still_inverted(const InsertionResult& result) {
+  return std::to_string(result.smoothing.inverted_after) + " tets are still inverted after " +
+         std::to_string(result.smoothing.sweeps.size()) + " sweeps";
+}
+
+std::string untangling_failure(const InsertionResult& result) {
+  return "smoothing could not untangle the mesh: " + tets_still_inverted(result);
+}
+
+// What an untangling failure means, and what may mend it besides the finer l_r the final message
+// suggests anyway.
+std::string untangling_explanation(const InsertionOptions& options) {
+  return options.smoothing.mode == SmoothingMode::band
+             ? "smoothing could not untangle the mesh, which the whole-mesh mode (--smoothing whole, "
+               "SmoothingMode::whole_mesh) may do"
+             : "smoothing could not untangle the mesh";
+}
+
+// A run of the stages that failed, for the final message: where it ran and why it failed, one line, and
+// what that kind of failure means (empty if the reason says it), which the message gives once however
+// many runs failed alike.
+struct FailedAttempt {
+  std::string settings;
+  std::string reason;
+  std::string explanation;
+};
+
+const char* side_rule_name(SideRule rule) {
+  switch (rule) {
+    case SideRule::positive_first: return "positive";
+    case SideRule::negative_first: return "negative";
+    case SideRule::positive_only: return "positive-only";
+    case SideRule::negative_only: return "negative-only";
+  }
+  return "";
+}
+
+// "0.05" when every surface has the same value, else "lower 0.025, upper 0.05".
+template <class Value, class Text>
+std::string per_surface(std::span<const TriangleSurface> surfaces, std::span<const Value> values, Text text) {
+  if (std::ranges::all_of(values, [&](const Value& value) { return value == values.front(); }))
+    return text(values.front());
+  std::string listed;
+  for (std::size_t s = 0; s < surfaces.size(); ++s) listed += (s > 0 ? ", " : "") + surfaces[s].name + " " + text(values[s]);
+  return listed;
+}
+
+// "l_r = 0.05, side positive" (the rule's --side name), per surface where they differ.
+std::string attempt_settings(std::span<const TriangleSurface> surfaces, std::span<const double> resolutions,
+                             std::span<const SideRule> rules) {
+  const auto number = [](double value) {
+    std::ostringstream text;
+    text << value;
+    return text.str();
+  };
+  return "l_r = " + per_surface(surfaces, resolutions, number) + ", side " +
+         per_surface(surfaces, rules, [](SideRule rule) { return std::string(side_rule_name(rule)); });
+}
+
+// The message of an insertion that failed for good: one line per attempt, the explanations of the kinds
+// of failure met, once each, and `outcome`: why no further attempt was made.
+std::string final_failure(std::span<const FailedAttempt> failed, const std::string& outcome) {
+  std::ostringstream message;
+  message << "the insertion failed (" << failed.size() << (failed.size() == 1 ? " attempt):" : " attempts):");
+  std::vector<std::string> explanations;
+  for (std::size_t k = 0; k < failed.size(); ++k) {
+    message << "\n  attempt " << k + 1 << " (" << failed[k].settings << "): " << failed[k].reason;
+    if (!failed[k].explanation.empty() && std::ranges::find(explanations, failed[k].explanation) == explanations.end())
+      explanations.push_back(failed[k].explanation);
+  }
+  message << '\n';
+  for (const std::string& explanation : explanations) message << explanation << "; ";
+  message << outcome;
+  return message.str();
 }
 
 // The surfaces with an S_M node in an inverted tet, in order.
@@ -237,27 +315,41 @@ SurfaceFailure untangling_surface_failure(std::vector<int> next, int count, cons
 
 // The stages at the given resolutions. A surface whose S_M cannot be untangled on one side of S may be
 // on the other: the stages run again from the input mesh with those surfaces' S_M on their other side,
-// as healing itself does. Throws SurfaceFailure when that fails too.
+// as healing itself does. Throws SurfaceFailure when that fails too. Each failed run is added to `failed`.
 InsertionResult insert_on_either_side(const TetMesh& mesh, std::span<const TriangleSurface> surfaces,
-                                      const InsertionOptions& options, std::span<const double> resolutions) {
+                                      const InsertionOptions& options, std::span<const double> resolutions,
+                                      std::vector<FailedAttempt>& failed) {
   const int count = static_cast<int>(surfaces.size());
   const std::vector<SideRule> rules(surfaces.size(), options.approximation.side_rule);
-  InsertionResult result = run_stages(mesh, surfaces, options, rules, resolutions);
+  auto run = [&](std::span<const SideRule> sides) {
+    try {
+      return run_stages(mesh, surfaces, options, sides, resolutions);
+    } catch (const SurfaceFailure& failure) {
+      failed.push_back({attempt_settings(surfaces, resolutions, sides), failure.what(), ""});
+      throw;
+    }
+  };
+  auto untangling_failed = [&](const InsertionResult& tangled, std::span<const SideRule> sides) {
+    failed.push_back(
+        {attempt_settings(surfaces, resolutions, sides), tets_still_inverted(tangled), untangling_explanation(options)});
+    return untangling_failure(tangled);
+  };
+  InsertionResult result = run(rules);
   if (options.last_stage != Stage::smoothing || surfaces.empty() || result.smoothing.untangled()) return result;
-  const std::string failure = untangling_failure(result, options);
+  const std::string failure = untangling_failed(result, rules);
   std::vector<int> next = surfaces_next_to_inverted_tets(result);
   const std::vector<SideRule> retry = other_side_rules(result, next, rules);
   if (retry.empty()) throw untangling_surface_failure(std::move(next), count, failure);
   report(options, "retrying with S_M on the other side of the surfaces next to inverted tets (", failure, ")");
   try {
-    result = run_stages(mesh, surfaces, options, retry, resolutions);
+    result = run(retry);
   } catch (const SurfaceFailure& other_side) {
     next.insert(next.end(), other_side.surfaces.begin(), other_side.surfaces.end());
     throw SurfaceFailure(std::move(next), failure + "; on the other side: " + other_side.what());
   }
   if (!result.smoothing.untangled())
     throw untangling_surface_failure(surfaces_next_to_inverted_tets(result), count,
-                                     failure + "; on the other side: " + untangling_failure(result, options));
+                                     failure + "; on the other side: " + untangling_failed(result, retry));
   result.side_retry = failure;
   return result;
 }
@@ -390,12 +482,13 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
   }
   const ThreadCount threads(options.threads);
   std::vector<double> resolutions(surfaces.size(), options.resolution);
-  std::vector<std::string> failures;  // of the attempts so far
+  std::vector<std::string> failures;  // why each finer retry was made, for the result
+  std::vector<FailedAttempt> failed;   // every run of the stages that failed, for the final message
   Clearances clearance;                // computed at the first failure
   for (int retry = 0;; ++retry) {
     std::vector<int> failing;
     try {
-      InsertionResult result = insert_on_either_side(mesh, surfaces, options, resolutions);
+      InsertionResult result = insert_on_either_side(mesh, surfaces, options, resolutions, failed);
       result.finer_retries = std::move(failures);
       result.estimated_tets = estimated_tets;
       result.seconds = seconds_since(pipeline_start);
@@ -404,14 +497,9 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
       failures.emplace_back(failure.what());
       failing = failure.surfaces;
     }
-    auto all_failures = [&] {
-      std::string joined = failures.front();
-      for (std::size_t k = 1; k < failures.size(); ++k) joined += "; then, at a finer l_r: " + failures[k];
-      return joined;
-    };
     if (retry == options.finer_retries)
-      throw MeshingError(all_failures() + "; more finer retries (--finer-retries, InsertionOptions::finer_retries; " +
-                         std::to_string(options.finer_retries) + " here) may succeed");
+      throw MeshingError(final_failure(failed, "more finer retries (--finer-retries, InsertionOptions::finer_retries; " +
+                                                   std::to_string(options.finer_retries) + " here) may succeed"));
     std::int64_t estimate = mesh.num_tets();
     std::ostringstream finer;
     finer.precision(6);
@@ -424,7 +512,7 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
     }
     for (std::size_t s = 0; s < surfaces.size(); ++s)
       estimate += estimate_tets(mesh.meccano, 0, surfaces.subspan(s, 1), resolutions[s]);
-    if (estimate > options.max_tets) throw MeshingError(all_failures() + "; a finer l_r would exceed the tet limit");
+    if (estimate > options.max_tets) throw MeshingError(final_failure(failed, "a finer l_r would exceed the tet limit"));
     report(options, "retrying with ", finer.str(), " (", failures.back(), ")");
   }
 }

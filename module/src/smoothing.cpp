@@ -597,6 +597,7 @@ SmoothingStats Smoother::run() {
                             stats_.sweeps.back().target == target_ && stats_.sweeps.back().inverted == 0;
     const double previous_objective = comparable ? stats_.sweeps.back().objective : infinity;
     stats_.sweeps.push_back(record);
+    if (options_.on_sweep) options_.on_sweep(sweep, record);
     // Untangling uses the paper's sum; once a sweep ends untangled, the next ones weigh bad tets more.
     tangled_ = record.inverted > 0;
     if (record.inverted > 0) {

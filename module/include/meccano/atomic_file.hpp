@@ -14,6 +14,12 @@ namespace meccano {
 
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+// Throws InputError ("cannot write PATH: why") unless a file can be written at `path`: its directory
+// exists and is writable, and the path is not a directory or another non-regular file. A tool checks
+// every output this way before a long computation, so that a mistyped path fails at once; the write
+// itself still reports what only shows then (a full disk).
+void check_writable(const std::string& path);
+
 // Several files that appear together or not at all. write(target, writer) has `writer` write the
 // target's content to a staged path next to it (any writer that takes a path: write_mesh, or
 // write_file_atomically); commit() renames the staged files over their targets in order. Destroyed

@@ -7,12 +7,17 @@
 //         type 0: the refinement edge is the cell diagonal, and this order is the one under which
 //         Kossaczky bisection produces exactly 3 similarity classes (notes §1.3). The Kuhn split is
 //         translation invariant, so neighbouring cells conform. Boundary faces carry their box-side tag.
-// Errors  InputError for an empty or inverted box, non-positive cell counts, or a negative level.
+// Errors  InputError for an empty, inverted or infinite box, cell counts outside 1..max_cells_per_axis, or
+//         a negative level.
 #pragma once
 
 #include <meccano/tet_mesh.hpp>
 
 namespace meccano {
+
+// The most cells along one axis: grid coordinate differences then stay below 2^41, which orientation
+// tests need to be exact in 127 bits (tet_mesh.cpp).
+inline constexpr int max_cells_per_axis = 1024;
 
 // Cell counts for equal cells as close to cubes as possible: the cell edge is the box's shortest
 // extent and each count is the nearest integer to extent / cell edge (a 2×1×1 box gives 2, 1, 1).

@@ -21,7 +21,7 @@
 // Output   the refined mesh, each surface's V_M, per-stage statistics and timings; surface_interfaces()
 //          lists each surface's faces with the tets on both sides, output_groups() the named groups the
 //          file writers take.
-// Progress a callback receives one line per stage with counts.
+// Progress a callback receives one line per stage with counts, and one per smoothing sweep.
 // Refusal before any refinement: l_r <= 0 (with surfaces), or an estimated tet count (estimate_tets) above
 //          options.max_tets, are InputErrors: an absurdly small l_r fails at once instead of exhausting memory.
 #pragma once
@@ -71,7 +71,7 @@ struct InsertionOptions {
   int threads = 0;                            // OpenMP threads for this call; 0 = OpenMP's default
   std::int64_t max_tets = default_max_tets;    // refuse when estimate_tets exceeds it
   int finer_retries = 2;                      // times a failing surface may be retried at a finer l_r
-  std::function<void(const std::string&)> progress;  // one line per stage, with counts
+  std::function<void(const std::string&)> progress;  // one line per stage and per smoothing sweep, with counts
 };
 
 struct SurfaceInsertion {

@@ -43,8 +43,9 @@
 //          (doc/results.md, Step 4). Should the meccano smoothing tangle the mesh again, the equilateral
 //          target is kept to the end.
 // Modes    whole mesh (the paper), or a band: only nodes within `band_rings` edge rings of an S_M node.
-// Output   the moved mesh and the surfaces' updated parameters; statistics per sweep. `untangled` is false
-//          if inverted tets remain: the caller must not present that mesh as a result.
+// Output   the moved mesh and the surfaces' updated parameters; statistics per sweep, also passed to
+//          `on_sweep` as each sweep ends. `untangled` is false if inverted tets remain: the caller must
+//          not present that mesh as a result.
 #pragma once
 
 #include <meccano/projection.hpp>
@@ -52,6 +53,7 @@
 #include <meccano/tet_mesh.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -59,6 +61,17 @@ namespace meccano {
 
 enum class SmoothingTarget { meccano, equilateral };
 enum class SmoothingMode { whole_mesh, band };
+
+struct SweepRecord {
+  std::int64_t inverted = 0;        // tets with σ <= 0 after the sweep
+  std::int64_t nodes_optimised = 0;
+  double min_quality = 0.0;         // 1/η against the target, over the tets of free nodes
+  double mean_quality = 0.0;
+  double power = 1.0;               // the exponent p the sweep minimised Σ η*^p with
+  SmoothingTarget target = SmoothingTarget::meccano;  // the target of the sweep's W
+  double objective = 0.0;           // Σ η^p over those tets after the sweep
+  double seconds = 0.0;
+};
 
 struct SmoothingOptions {
   SmoothingTarget target = SmoothingTarget::meccano;
@@ -71,17 +84,9 @@ struct SmoothingOptions {
   double tolerance = 1e-3;
   double power = 4.0;    // p of Σ η*^p once untangled; 1 is the paper's objective
   int newton_steps = 2;  // per node and sweep
-};
-
-struct SweepRecord {
-  std::int64_t inverted = 0;        // tets with σ <= 0 after the sweep
-  std::int64_t nodes_optimised = 0;
-  double min_quality = 0.0;         // 1/η against the target, over the tets of free nodes
-  double mean_quality = 0.0;
-  double power = 1.0;               // the exponent p the sweep minimised Σ η*^p with
-  SmoothingTarget target = SmoothingTarget::meccano;  // the target of the sweep's W
-  double objective = 0.0;           // Σ η^p over those tets after the sweep
-  double seconds = 0.0;
+  // Called after each sweep with its number (from 1) and record, for progress on long runs (SUS can take
+  // minutes without another stage line); nothing is done for it when empty. The sweeps do not depend on it.
+  std::function<void(int sweep, const SweepRecord& record)> on_sweep = nullptr;
 };
 
 struct SmoothingStats {

@@ -29,6 +29,14 @@ found_under_prefix() {
   case $2 in "$prefix"/*) ;; *) echo "run_consumer.sh: $1 found at $2, not under $prefix" >&2; exit 1 ;; esac
 }
 
+# Configures and builds the CMake project in $1 against the installed package, in $out.
+build_with_cmake() {
+  fresh_dir "$out"
+  "$cmake" -S "$1" -B "$out" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release
+  found_under_prefix MeccanoImmerse "$(sed -n 's/^MeccanoImmerse_DIR:PATH=//p' "$out/CMakeCache.txt")"
+  "$cmake" --build "$out"
+}
+
 case $step in
   install)
     [ $# -eq 3 ] || { echo "$usage" >&2; exit 2; }
@@ -36,10 +44,7 @@ case $step in
     "$cmake" --install "$3" --prefix "$prefix"
     ;;
   cmake)
-    fresh_dir "$out"
-    "$cmake" -S "$consumer_dir" -B "$out" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release
-    found_under_prefix MeccanoImmerse "$(sed -n 's/^MeccanoImmerse_DIR:PATH=//p' "$out/CMakeCache.txt")"
-    "$cmake" --build "$out"
+    build_with_cmake "$consumer_dir"
     "$out/consumer"
     ;;
   pkg-config)
@@ -54,10 +59,7 @@ case $step in
     LD_LIBRARY_PATH=$(pkg-config --variable=libdir meccano-immerse) "$out/consumer"
     ;;
   dealii)
-    fresh_dir "$out"
-    "$cmake" -S "$consumer_dir/../consumer_dealii" -B "$out" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release
-    found_under_prefix MeccanoImmerse "$(sed -n 's/^MeccanoImmerse_DIR:PATH=//p' "$out/CMakeCache.txt")"
-    "$cmake" --build "$out"
+    build_with_cmake "$consumer_dir/../consumer_dealii"
     "$out/flux_jump"
     "$prefix/bin/meccano-immerse" --box 0,0,0,1,1,1 --level 1 --surface "$consumer_dir/../../meshes/spherical_cap.obj:cap" \
       --resolution 0.08 --quiet --output "$out/cap.msh"

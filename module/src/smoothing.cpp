@@ -52,23 +52,42 @@ double regularised_distortion(double frobenius_squared, double sigma, double del
   return h > 0.0 ? frobenius_squared / (3.0 * std::cbrt(h * h)) : infinity;
 }
 
-// f, ∇f and ∇²f of the tet with vertex k free (no derivatives where f is infinite).
-Distortion distortion_derivatives(const Matrix3d& s, const Matrix3d& target_inverse, int k, double delta) {
-  Distortion d;
-  const double n = s.squaredNorm();
-  const double sigma = s.determinant();
-  const double r = std::sqrt(sigma * sigma + 4.0 * delta * delta);
-  d.value = regularised_distortion(n, sigma, delta);
-  if (!std::isfinite(d.value)) return d;
+// One tet as a function of the free vertex's displacement d from where the star was taken. Only that
+// vertex moves, so S changes by a rank-one term, S(d) = S0 + d bᵀ, and exactly (the matrix determinant
+// lemma for σ):
+//   N(d) = N0 + 2 d·u + |d|² β   with u = S0 b, β = |b|²;      σ(d) = σ0 + d·w   with w = cof(S0) b.
+// Nine numbers per tet then give f, ∇f and ∇²f anywhere, with no vertex gathered and no matrix product:
+// a node's Newton steps and line search cost a few flops per tet of its star.
+struct StarTet {
+  double n0 = 0.0, beta = 0.0, sigma0 = 0.0;
+  Vector3d u = Vector3d::Zero(), w = Vector3d::Zero();
+};
+
+StarTet star_tet(const Matrix3d& s, const Matrix3d& target_inverse, int k) {
   const Vector3d b = k == 0 ? Vector3d(-target_inverse.colwise().sum().transpose()) : Vector3d(target_inverse.row(k - 1));
-  const Vector3d grad_n = 2.0 * s * b;
-  const Vector3d grad_sigma = cofactor(s) * b;
-  const Vector3d a = grad_n / n - (2.0 / 3.0) * grad_sigma / r;
-  d.gradient = d.value * a;
-  d.hessian = d.value * (a * a.transpose() + (2.0 * b.squaredNorm() / n) * Matrix3d::Identity() -
+  return {s.squaredNorm(), b.squaredNorm(), s.determinant(), s * b, cofactor(s) * b};
+}
+
+double distortion_at(const StarTet& tet, const Vector3d& d, double delta) {
+  return regularised_distortion(tet.n0 + 2.0 * d.dot(tet.u) + d.squaredNorm() * tet.beta, tet.sigma0 + d.dot(tet.w),
+                                delta);
+}
+
+// f, ∇f and ∇²f at d (no derivatives where f is infinite).
+Distortion distortion_derivatives(const StarTet& tet, const Vector3d& d, double delta) {
+  Distortion f;
+  const double n = tet.n0 + 2.0 * d.dot(tet.u) + d.squaredNorm() * tet.beta;
+  const double sigma = tet.sigma0 + d.dot(tet.w);
+  f.value = regularised_distortion(n, sigma, delta);
+  if (!std::isfinite(f.value)) return f;
+  const double r = std::sqrt(sigma * sigma + 4.0 * delta * delta);
+  const Vector3d grad_n = 2.0 * (tet.u + tet.beta * d);
+  const Vector3d a = grad_n / n - (2.0 / 3.0) * tet.w / r;
+  f.gradient = f.value * a;
+  f.hessian = f.value * (a * a.transpose() + (2.0 * tet.beta / n) * Matrix3d::Identity() -
                          grad_n * grad_n.transpose() / (n * n) +
-                         (2.0 / 3.0) * sigma / (r * r * r) * grad_sigma * grad_sigma.transpose());
-  return d;
+                         (2.0 / 3.0) * sigma / (r * r * r) * tet.w * tet.w.transpose());
+  return f;
 }
 
 // f^p, with the exponents SUS uses (1 while untangling, 4 after) spared a call to std::pow.
@@ -93,6 +112,24 @@ void add_power(const Distortion& d, double power, Distortion& sum) {
   const double first = power * f_to_p / f;
   sum.gradient += first * d.gradient;
   sum.hessian += first * d.hessian + (power - 1.0) * first / f * d.gradient * d.gradient.transpose();
+}
+
+// The Newton direction -H⁻¹g in a node's parameters (j: dx/dparameters, whose zero columns are parameters
+// the node does not have), with H's eigenvalues made positive (|λ|, bounded away from 0) so that the
+// direction descends even where the objective is not convex. Where H is positive definite with no tiny
+// pivot that is plain Newton: a Cholesky solve gives it without the eigen-decomposition.
+Parameters descent_direction(Matrix3d h, const Parameters& g, const Jacobian& j) {
+  for (int i = 0; i < 3; ++i)
+    if (j.col(i).squaredNorm() == 0.0) h(i, i) = 1.0;  // an unused parameter: g_i = 0, so its step is 0
+  const Eigen::LLT<Matrix3d> cholesky(h);
+  if (cholesky.info() == Eigen::Success &&
+      cholesky.matrixLLT().diagonal().cwiseAbs2().minCoeff() >= 1e-8 * h.trace())
+    return -cholesky.solve(g);
+  const Eigen::SelfAdjointEigenSolver<Matrix3d> eigen(h);
+  Parameters magnitudes = eigen.eigenvalues().cwiseAbs();
+  const double floor = std::max(1e-8 * magnitudes.maxCoeff(), std::numeric_limits<double>::min());
+  magnitudes = magnitudes.cwiseMax(floor);
+  return -(eigen.eigenvectors() * (eigen.eigenvectors().transpose() * g).cwiseQuotient(magnitudes));
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -159,18 +196,16 @@ class Smoother {
         if (w != v) visit(w);
   }
 
-  Matrix3d s_matrix(TetId t, VertexId v, const Vector3d& x, int& local) const {
-    std::array<Vector3d, 4> p;
-    for (int i = 0; i < 4; ++i) {
-      const VertexId w = oriented_[t][i];
-      if (w == v) local = i;
-      p[i] = w == v ? x : mesh_.points[w];
-    }
-    return edge_matrix(p) * target_inverse_[t];
+  // S = A W^-1 of tet t at the current positions.
+  Matrix3d s_matrix(TetId t) const {
+    const auto& v = oriented_[t];
+    return edge_matrix({mesh_.points[v[0]], mesh_.points[v[1]], mesh_.points[v[2]], mesh_.points[v[3]]}) *
+           target_inverse_[t];
   }
-  double star_objective(VertexId v, const Vector3d& x, double delta) const;
-  Distortion star_derivatives(VertexId v, const Vector3d& x, double delta) const;
-  double choose_delta(VertexId v, double& length, bool& tangled_star) const;
+  std::span<const StarTet> take_star(VertexId v) const;
+  double star_objective(std::span<const StarTet> star, const Vector3d& d, double delta) const;
+  Distortion star_derivatives(std::span<const StarTet> star, const Vector3d& d, double delta) const;
+  double choose_delta(VertexId v, std::span<const StarTet> star, double& length, bool& tangled_star) const;
 
   Placement placement(VertexId v) const;
   Jacobian jacobian(VertexId v, const Placement& at) const;
@@ -295,23 +330,27 @@ std::vector<std::vector<VertexId>> Smoother::colour(const std::vector<VertexId>&
   return colours;
 }
 
-double Smoother::star_objective(VertexId v, const Vector3d& x, double delta) const {
-  double value = 0.0;
-  int local = 0;
+// The star of v at its current position, in a buffer of the calling thread (nodes are optimised in
+// parallel); valid until the thread takes the next star.
+std::span<const StarTet> Smoother::take_star(VertexId v) const {
+  thread_local std::vector<StarTet> star;
+  star.clear();
   for (TetId t : stars_.of(v)) {
-    const Matrix3d s = s_matrix(t, v, x, local);
-    value += raise(regularised_distortion(s.squaredNorm(), s.determinant(), delta), power());
+    const int local = static_cast<int>(std::find(oriented_[t].begin(), oriented_[t].end(), v) - oriented_[t].begin());
+    star.push_back(star_tet(s_matrix(t), target_inverse_[t], local));
   }
+  return star;
+}
+
+double Smoother::star_objective(std::span<const StarTet> star, const Vector3d& d, double delta) const {
+  double value = 0.0;
+  for (const StarTet& tet : star) value += raise(distortion_at(tet, d, delta), power());
   return value;
 }
 
-Distortion Smoother::star_derivatives(VertexId v, const Vector3d& x, double delta) const {
+Distortion Smoother::star_derivatives(std::span<const StarTet> star, const Vector3d& d, double delta) const {
   Distortion sum;
-  int local = 0;
-  for (TetId t : stars_.of(v)) {
-    const Matrix3d s = s_matrix(t, v, x, local);
-    add_power(distortion_derivatives(s, target_inverse_[t], local, delta), power(), sum);
-  }
+  for (const StarTet& tet : star) add_power(distortion_derivatives(tet, d, delta), power(), sum);
   return sum;
 }
 
@@ -322,14 +361,11 @@ Distortion Smoother::star_derivatives(VertexId v, const Vector3d& x, double delt
 // with 5 tets inverted after 100 sweeps: each sat in a local minimum behind S. ε = 1e-3 · mean|σ|
 // smooths the objective where the star is tangled and untangled it in 4 sweeps; on valid stars δ is
 // the floor, so the smoothing itself is unchanged.
-double Smoother::choose_delta(VertexId v, double& length, bool& tangled_star) const {
+double Smoother::choose_delta(VertexId v, std::span<const StarTet> star, double& length, bool& tangled_star) const {
   double sigma_min = infinity, sigma_sum = 0.0;
-  int local = 0;
-  const auto star = stars_.of(v);
-  for (TetId t : star) {
-    const double sigma = s_matrix(t, v, mesh_.points[v], local).determinant();
-    sigma_min = std::min(sigma_min, sigma);
-    sigma_sum += std::abs(sigma);
+  for (const StarTet& tet : star) {
+    sigma_min = std::min(sigma_min, tet.sigma0);
+    sigma_sum += std::abs(tet.sigma0);
   }
   double edges = 0.0;
   int count = 0;
@@ -452,25 +488,19 @@ bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& u
 // (revisiting every node then made the last untangling sweeps cost as much as the first: twice the
 // seconds per tet on faults whose last inverted tets took 20 sweeps).
 bool Smoother::optimise(VertexId v) {
+  const std::span<const StarTet> star = take_star(v);
   double length = 0.0;
   bool tangled_star = false;
-  const double delta = choose_delta(v, length, tangled_star);
+  const double delta = choose_delta(v, star, length, tangled_star);
   const Placement start = placement(v);
   Placement at = start;
   for (int step = 0, steps = tangled_ ? 2 * options_.newton_steps : options_.newton_steps; step < steps; ++step) {
-    const Distortion star = star_derivatives(v, at.x, delta);
-    const double value = star.value;
+    const Distortion model = star_derivatives(star, at.x - start.x, delta);
+    const double value = model.value;
     const Jacobian j = jacobian(v, at);
-    const Parameters g = j.transpose() * star.gradient;
+    const Parameters g = j.transpose() * model.gradient;
     if (!std::isfinite(value) || g.norm() * length <= 1e-12 * value) break;
-    // Newton direction with the Hessian's eigenvalues made positive (|λ|, bounded away from 0), so the
-    // direction descends even where the objective is not convex.
-    const Eigen::SelfAdjointEigenSolver<Matrix3d> eigen(j.transpose() * star.hessian * j);
-    Parameters magnitudes = eigen.eigenvalues().cwiseAbs();
-    const double floor = std::max(1e-8 * magnitudes.maxCoeff(), std::numeric_limits<double>::min());
-    magnitudes = magnitudes.cwiseMax(floor);
-    Parameters direction =
-        -(eigen.eigenvectors() * (eigen.eigenvectors().transpose() * g).cwiseQuotient(magnitudes));
+    Parameters direction = descent_direction(j.transpose() * model.hessian * j, g, j);
     // At most half the star's edge length per step: the quadratic model means little beyond that.
     const double physical = (j * direction).norm();
     if (physical > 0.5 * length) direction *= 0.5 * length / physical;
@@ -479,7 +509,7 @@ bool Smoother::optimise(VertexId v) {
     bool accepted = false;
     for (double alpha = 1.0; alpha > 1e-6 && !accepted; alpha *= 0.5)
       accepted = move(v, at, alpha * direction, trial) &&
-                 star_objective(v, trial.x, delta) <= value + 1e-4 * alpha * slope;
+                 star_objective(star, trial.x - start.x, delta) <= value + 1e-4 * alpha * slope;
     if (!accepted) break;
     const double moved = (trial.x - at.x).norm();
     at = trial;
@@ -509,8 +539,7 @@ SweepRecord Smoother::measure() const {
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < count; ++i) {
     const TetId t = active_tets_[i];
-    int local = 0;
-    const Matrix3d s = s_matrix(t, oriented_[t][0], mesh_.points[oriented_[t][0]], local);
+    const Matrix3d s = s_matrix(t);
     const double sigma = s.determinant();
     distortion[i] = sigma > 0.0 ? s.squaredNorm() / (3.0 * std::cbrt(sigma * sigma)) : infinity;
   }
@@ -636,7 +665,8 @@ SmoothingStats Smoother::run() {
 
 Distortion regularised_distortion(const TetPoints& physical, const Matrix3d& target_inverse, int vertex,
                                   double delta) {
-  return distortion_derivatives(edge_matrix(physical) * target_inverse, target_inverse, vertex, delta);
+  return distortion_derivatives(star_tet(edge_matrix(physical) * target_inverse, target_inverse, vertex), Vector3d::Zero(),
+                                delta);
 }
 
 SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, const SmoothingOptions& options) {

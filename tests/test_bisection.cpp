@@ -93,6 +93,12 @@ TEST(CubeMeccano, CellsAreAsCloseToCubesAsPossible) {
   EXPECT_EQ(cells_for_box({{0, 0, 0}, {3, 2, 1}}), (std::array<int, 3>{3, 2, 1}));
   EXPECT_EQ(cells_for_box({{0, 0, 0}, {1, 1.3, 0.6}}), (std::array<int, 3>{2, 2, 1}));
   EXPECT_THROW(cells_for_box({{0, 0, 0}, {1, 0, 1}}), InputError);
+  try {
+    cells_for_box({{0, 0, 0}, {2000, 1, 1}});
+    ADD_FAILURE() << "no error for a 2000:1 box";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("longer along x than its shortest side"), std::string::npos) << error.what();
+  }
   EXPECT_THROW(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, {0, 1, 1}), InputError);
   EXPECT_THROW(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, -1), InputError);
 }

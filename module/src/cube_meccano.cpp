@@ -44,7 +44,18 @@ std::array<int, 3> cells_for_box(const Box& box) {
   const Eigen::Vector3d extent = box.extent();
   const double edge = extent.minCoeff();
   std::array<int, 3> cells{};
-  for (int k = 0; k < 3; ++k) cells[k] = std::max(1, static_cast<int>(std::lround(extent[k] / edge)));
+  for (int k = 0; k < 3; ++k) {
+    const double count = std::max(1.0, std::round(extent[k] / edge));
+    // Said in terms of the box: the count is a number the caller never gave.
+    if (count > max_cells_per_axis) {
+      std::ostringstream ratio;
+      ratio << extent[k] / edge;
+      throw InputError("the box is " + ratio.str() + " times longer along " + "xyz"[k] +
+                       " than its shortest side: cells as close to cubes as possible would be more than " +
+                       std::to_string(max_cells_per_axis) + " along it; give the cell counts");
+    }
+    cells[k] = static_cast<int>(count);
+  }
   return cells;
 }
 

@@ -83,13 +83,13 @@ void write_report(const std::string& path, const Options& options, const meccano
   meccano::write_file_atomically(path, [&text](std::ostream& out) { out << text; });
 }
 
-// The interface `name` of the file's mesh (empty: its only one), or an InputError naming the file.
-const meccano::DealiiInterface& file_interface(const meccano::DealiiMesh& mesh, const std::string& path,
-                                               const std::string& name) {
+// The interface `name` of the file's mesh (empty: its only one); where the file has several, the error
+// says which option names one.
+const meccano::DealiiInterface& file_interface(const meccano::DealiiMesh& mesh, const std::string& name) {
   try {
     return mesh.interface(name);
   } catch (const meccano::InputError& error) {
-    throw meccano::InputError(path + ": " + error.what() + (name.empty() ? " with --interface" : ""));
+    throw meccano::InputError(error.what() + std::string(name.empty() ? " with --interface" : ""));
   }
 }
 
@@ -106,7 +106,7 @@ void solve(MPI_Comm communicator, const Options& options) {
   SurfaceMatch match;
   if (root) {
     mesh = meccano::read_dealii_mesh(options.at("--mesh"));
-    interface = &file_interface(mesh, options.at("--mesh"), interface_name);
+    interface = &file_interface(mesh, interface_name);
     match = match_cube_example_surface(*interface);
   }
   const double read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

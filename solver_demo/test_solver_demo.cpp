@@ -451,7 +451,7 @@ TEST_F(AdapterTest, BadFilesAreRefusedWithTheirDefect) {
 
   // Two interfaces: the name must be given.
   const meccano::DealiiMesh mesh = meccano::read_dealii_mesh(changed_file(result, "two.msh", copy_interface_patch));
-  expect_input_error([&] { mesh.interface(); }, {"2 interfaces", "interface_patch, interface_copy", "name the one"});
+  expect_input_error([&] { mesh.interface(); }, {"two.msh: 2 interfaces", "interface_patch, interface_copy", "name the one"});
   expect_input_error([&] { mesh.interface("fault"); }, {"no interface_fault", "interface_patch, interface_copy"});
   EXPECT_EQ(mesh.interface("copy").tag, 8);
   EXPECT_EQ(oriented_triangles(mesh.interface("patch")), oriented_triangles(meccano::dealii_mesh(result).interface()));

@@ -3,7 +3,7 @@
 // not part of the installed library.
 #pragma once
 
-#include <meccano/box.hpp>
+#include <meccano/cube_meccano.hpp>
 
 #include <array>
 #include <cctype>
@@ -32,18 +32,13 @@ double parse_finite_number(const std::string& option, const std::string& text) {
   return value;
 }
 
-// The box of six numbers, the minimum corner first. A box the meccano cannot fill (a minimum not below its
-// maximum, or an extent too large for a double) is a malformed option: Error (the tool's usage error)
-// naming the option and the axis.
+// The box of six numbers, the minimum corner first. A box the meccano cannot fill (box_defect) is a
+// malformed option: Error (the tool's usage error) naming the option and the defect.
 template <class Error>
 Box box_from_numbers(const std::string& option, const std::array<double, 6>& v) {
-  for (int k = 0; k < 3; ++k) {
-    std::ostringstream message;
-    message << option << ": on axis " << "xyz"[k] << " the minimum " << v[k] << " must be below the maximum " << v[k + 3];
-    if (!(v[k] < v[k + 3])) throw Error(message.str());
-    if (!std::isfinite(v[k + 3] - v[k])) throw Error(message.str() + " by a finite extent");
-  }
-  return {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+  const Box box{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+  if (const std::string defect = box_defect(box); !defect.empty()) throw Error(option + ": " + defect);
+  return box;
 }
 
 // FILE[:NAME] as (file, name), NAME defaulting to the surface's 1-based position. A colon followed by a

@@ -11,13 +11,7 @@ namespace meccano {
 namespace {
 
 void check_box(const Box& box) {
-  for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(box.max[k] - box.min[k]) || !(box.min[k] < box.max[k])) {
-      std::ostringstream message;
-      message << "invalid box: on axis " << "xyz"[k] << " the lower bound " << box.min[k]
-              << " is not below the upper bound " << box.max[k] << " by a finite extent";
-      throw InputError(message.str());
-    }
+  if (const std::string defect = box_defect(box); !defect.empty()) throw InputError("invalid box: " + defect);
 }
 
 // Tags every face without a neighbour by the box side its vertices lie on.
@@ -38,6 +32,17 @@ void tag_box_sides(TetMesh& mesh) {
 }
 
 }  // namespace
+
+std::string box_defect(const Box& box) {
+  for (int k = 0; k < 3; ++k)
+    if (!(box.min[k] < box.max[k]) || !std::isfinite(box.max[k] - box.min[k])) {
+      std::ostringstream defect;
+      defect << "on axis " << "xyz"[k] << " the minimum " << box.min[k] << " must be below the maximum " << box.max[k];
+      if (box.min[k] < box.max[k]) defect << " by a finite extent";
+      return defect.str();
+    }
+  return "";
+}
 
 std::array<int, 3> cells_for_box(const Box& box) {
   check_box(box);

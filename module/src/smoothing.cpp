@@ -62,6 +62,9 @@ double regularised_distortion(double frobenius_squared, double sigma, double del
 struct StarTet {
   double n0 = 0.0, beta = 0.0, sigma0 = 0.0;
   Vector3d u = Vector3d::Zero(), w = Vector3d::Zero();
+
+  double frobenius_squared(const Vector3d& d) const { return n0 + 2.0 * d.dot(u) + d.squaredNorm() * beta; }
+  double sigma(const Vector3d& d) const { return sigma0 + d.dot(w); }
 };
 
 StarTet star_tet(const Matrix3d& s, const Matrix3d& target_inverse, int k) {
@@ -70,15 +73,14 @@ StarTet star_tet(const Matrix3d& s, const Matrix3d& target_inverse, int k) {
 }
 
 double distortion_at(const StarTet& tet, const Vector3d& d, double delta) {
-  return regularised_distortion(tet.n0 + 2.0 * d.dot(tet.u) + d.squaredNorm() * tet.beta, tet.sigma0 + d.dot(tet.w),
-                                delta);
+  return regularised_distortion(tet.frobenius_squared(d), tet.sigma(d), delta);
 }
 
 // f, ∇f and ∇²f at d (no derivatives where f is infinite).
 Distortion distortion_derivatives(const StarTet& tet, const Vector3d& d, double delta) {
   Distortion f;
-  const double n = tet.n0 + 2.0 * d.dot(tet.u) + d.squaredNorm() * tet.beta;
-  const double sigma = tet.sigma0 + d.dot(tet.w);
+  const double n = tet.frobenius_squared(d);
+  const double sigma = tet.sigma(d);
   f.value = regularised_distortion(n, sigma, delta);
   if (!std::isfinite(f.value)) return f;
   const double r = std::sqrt(sigma * sigma + 4.0 * delta * delta);

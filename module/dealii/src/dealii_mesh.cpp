@@ -97,8 +97,8 @@ const DealiiInterface& DealiiMesh::interface(const std::string& name) const {
     if (candidate.name == name || (name.empty() && interfaces.size() == 1)) return candidate;
     names += (names.empty() ? "interface_" : ", interface_") + candidate.name;
   }
-  throw InputError((name.empty() ? std::to_string(interfaces.size()) + " interfaces"
-                                 : "no interface_" + name) +
+  throw InputError((source.empty() ? "" : source + ": ") +
+                   (name.empty() ? std::to_string(interfaces.size()) + " interfaces" : "no interface_" + name) +
                    " in the mesh (" + (names.empty() ? "none" : names) + ")" +
                    (name.empty() ? ": name the one to use" : ""));
 }
@@ -138,6 +138,7 @@ DealiiMesh read_dealii_mesh(const std::string& msh_path) {
   for (const auto& tet : file.tets)
     for (const int node : tet) vertex_of_node[node] = 0;
   DealiiMesh mesh;
+  mesh.source = msh_path;
   for (std::size_t node = 0; node < file.points.size(); ++node)
     if (vertex_of_node[node] == 0) {
       vertex_of_node[node] = static_cast<unsigned int>(mesh.vertices.size());

@@ -13,11 +13,18 @@
 
 #include <meccano/tet_mesh.hpp>
 
+#include <string>
+
 namespace meccano {
 
 // The most cells along one axis: grid coordinate differences then stay below 2^41, which orientation
 // tests need to be exact in 127 bits (tet_mesh.cpp).
 inline constexpr int max_cells_per_axis = 1024;
+
+// Why the meccano cannot fill `box`, naming the axis ("on axis y the minimum 1 must be below the maximum
+// 0", or "... by a finite extent" when max − min overflows), or an empty string if it can. The library
+// throws InputError("invalid box: " + defect); the command-line tools make it a usage error.
+std::string box_defect(const Box& box);
 
 // Cell counts for equal cells as close to cubes as possible: the cell edge is the box's shortest
 // extent and each count is the nearest integer to extent / cell edge (a 2×1×1 box gives 2, 1, 1).

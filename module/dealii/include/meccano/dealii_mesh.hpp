@@ -53,13 +53,14 @@ struct DealiiInterface {
 };
 
 struct DealiiMesh {
+  std::string source;  // the MSH file read, for messages (empty for an InsertionResult)
   std::vector<dealii::Point<3>> vertices;
   std::vector<dealii::CellData<3>> cells;
   dealii::SubCellData faces;  // box sides and interface faces, in boundary_quads
   std::vector<DealiiInterface> interfaces;
 
-  // The interface of that NAME, or the only one when `name` is empty. Throws InputError listing the
-  // interfaces otherwise.
+  // The interface of that NAME, or the only one when `name` is empty. Throws InputError naming the source
+  // and listing the interfaces otherwise.
   const DealiiInterface& interface(const std::string& name = "") const;
 };
 

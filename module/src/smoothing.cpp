@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 
 namespace meccano {
@@ -52,23 +53,44 @@ double regularised_distortion(double frobenius_squared, double sigma, double del
   return h > 0.0 ? frobenius_squared / (3.0 * std::cbrt(h * h)) : infinity;
 }
 
-// f, ∇f and ∇²f of the tet with vertex k free (no derivatives where f is infinite).
-Distortion distortion_derivatives(const Matrix3d& s, const Matrix3d& target_inverse, int k, double delta) {
-  Distortion d;
-  const double n = s.squaredNorm();
-  const double sigma = s.determinant();
-  const double r = std::sqrt(sigma * sigma + 4.0 * delta * delta);
-  d.value = regularised_distortion(n, sigma, delta);
-  if (!std::isfinite(d.value)) return d;
+// One tet as a function of the free vertex's displacement d from where the star was taken. Only that
+// vertex moves, so S changes by a rank-one term, S(d) = S0 + d bᵀ, and exactly (the matrix determinant
+// lemma for σ):
+//   N(d) = N0 + 2 d·u + |d|² β   with u = S0 b, β = |b|²;      σ(d) = σ0 + d·w   with w = cof(S0) b.
+// Nine numbers per tet then give f, ∇f and ∇²f anywhere, with no vertex gathered and no matrix product:
+// a node's Newton steps and line search cost a few flops per tet of its star.
+struct StarTet {
+  double n0 = 0.0, beta = 0.0, sigma0 = 0.0;
+  Vector3d u = Vector3d::Zero(), w = Vector3d::Zero();
+
+  double frobenius_squared(const Vector3d& d) const { return n0 + 2.0 * d.dot(u) + d.squaredNorm() * beta; }
+  double sigma(const Vector3d& d) const { return sigma0 + d.dot(w); }
+};
+
+StarTet star_tet(const Matrix3d& s, const Matrix3d& target_inverse, int k) {
   const Vector3d b = k == 0 ? Vector3d(-target_inverse.colwise().sum().transpose()) : Vector3d(target_inverse.row(k - 1));
-  const Vector3d grad_n = 2.0 * s * b;
-  const Vector3d grad_sigma = cofactor(s) * b;
-  const Vector3d a = grad_n / n - (2.0 / 3.0) * grad_sigma / r;
-  d.gradient = d.value * a;
-  d.hessian = d.value * (a * a.transpose() + (2.0 * b.squaredNorm() / n) * Matrix3d::Identity() -
+  return {s.squaredNorm(), b.squaredNorm(), s.determinant(), s * b, cofactor(s) * b};
+}
+
+double distortion_at(const StarTet& tet, const Vector3d& d, double delta) {
+  return regularised_distortion(tet.frobenius_squared(d), tet.sigma(d), delta);
+}
+
+// f, ∇f and ∇²f at d (no derivatives where f is infinite).
+Distortion distortion_derivatives(const StarTet& tet, const Vector3d& d, double delta) {
+  Distortion f;
+  const double n = tet.frobenius_squared(d);
+  const double sigma = tet.sigma(d);
+  f.value = regularised_distortion(n, sigma, delta);
+  if (!std::isfinite(f.value)) return f;
+  const double r = std::sqrt(sigma * sigma + 4.0 * delta * delta);
+  const Vector3d grad_n = 2.0 * (tet.u + tet.beta * d);
+  const Vector3d a = grad_n / n - (2.0 / 3.0) * tet.w / r;
+  f.gradient = f.value * a;
+  f.hessian = f.value * (a * a.transpose() + (2.0 * tet.beta / n) * Matrix3d::Identity() -
                          grad_n * grad_n.transpose() / (n * n) +
-                         (2.0 / 3.0) * sigma / (r * r * r) * grad_sigma * grad_sigma.transpose());
-  return d;
+                         (2.0 / 3.0) * sigma / (r * r * r) * tet.w * tet.w.transpose());
+  return f;
 }
 
 // f^p, with the exponents SUS uses (1 while untangling, 4 after) spared a call to std::pow.
@@ -93,6 +115,24 @@ void add_power(const Distortion& d, double power, Distortion& sum) {
   const double first = power * f_to_p / f;
   sum.gradient += first * d.gradient;
   sum.hessian += first * d.hessian + (power - 1.0) * first / f * d.gradient * d.gradient.transpose();
+}
+
+// The Newton direction -H⁻¹g in a node's parameters (j: dx/dparameters, whose zero columns are parameters
+// the node does not have), with H's eigenvalues made positive (|λ|, bounded away from 0) so that the
+// direction descends even where the objective is not convex. Where H is positive definite with no tiny
+// pivot that is plain Newton: a Cholesky solve gives it without the eigen-decomposition.
+Parameters descent_direction(Matrix3d h, const Parameters& g, const Jacobian& j) {
+  for (int i = 0; i < 3; ++i)
+    if (j.col(i).squaredNorm() == 0.0) h(i, i) = 1.0;  // an unused parameter: g_i = 0, so its step is 0
+  const Eigen::LLT<Matrix3d> cholesky(h);
+  if (cholesky.info() == Eigen::Success &&
+      cholesky.matrixLLT().diagonal().cwiseAbs2().minCoeff() >= 1e-8 * h.trace())
+    return -cholesky.solve(g);
+  const Eigen::SelfAdjointEigenSolver<Matrix3d> eigen(h);
+  Parameters magnitudes = eigen.eigenvalues().cwiseAbs();
+  const double floor = std::max(1e-8 * magnitudes.maxCoeff(), std::numeric_limits<double>::min());
+  magnitudes = magnitudes.cwiseMax(floor);
+  return -(eigen.eigenvectors() * (eigen.eigenvectors().transpose() * g).cwiseQuotient(magnitudes));
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -137,17 +177,36 @@ class Smoother {
     w << 1.0, 0.5, 0.5, 0.0, std::sqrt(3.0) / 2.0, std::sqrt(3.0) / 6.0, 0.0, 0.0, std::sqrt(2.0 / 3.0);
     return w;
   }
-  // Sets every tet's W^-1 for `target`.
+  // Sets every tet's W^-1 for `target`. The meccano's tets come in few shapes (the bisection's, level by
+  // level), so each W^-1 is kept once per shape, keyed by the tet's exact edge matrix in grid coordinates,
+  // and a tet holds the index of its own: a node's star then reads a small table that stays in cache
+  // instead of 72 bytes per tet from all over memory.
   void aim_at(SmoothingTarget target) {
     target_ = target;
-    target_inverse_.resize(mesh_.tets.size());
-    const Matrix3d equilateral_inverse = equilateral_target().inverse();
-#pragma omp parallel for schedule(static)
-    for (TetId t = 0; t < mesh_.num_tets(); ++t)
-      target_inverse_[t] = target == SmoothingTarget::meccano
-                               ? Matrix3d(edge_matrix(oriented_computational_points(mesh_, t)).inverse())
-                               : equilateral_inverse;
+    target_inverses_.clear();
+    target_of_tet_.assign(mesh_.tets.size(), 0);
+    if (target == SmoothingTarget::equilateral) {
+      target_inverses_.push_back(equilateral_target().inverse());
+      return;
+    }
+    std::map<std::array<std::int64_t, 9>, std::uint32_t> shape_index;
+    for (TetId t = 0; t < mesh_.num_tets(); ++t) {
+      const auto& v = oriented_[t];
+      std::array<std::int64_t, 9> edges;
+      for (int k = 0; k < 3; ++k)
+        for (int axis = 0; axis < 3; ++axis) edges[3 * k + axis] = mesh_.grid[v[k + 1]][axis] - mesh_.grid[v[0]][axis];
+      const auto [shape, added] = shape_index.try_emplace(edges, static_cast<std::uint32_t>(target_inverses_.size()));
+      if (added) {
+        Matrix3d w;
+        for (int k = 0; k < 3; ++k)
+          for (int axis = 0; axis < 3; ++axis)
+            w(axis, k) = mesh_.meccano.cell_size[axis] * static_cast<double>(edges[3 * k + axis]) / static_cast<double>(grid_cell);
+        target_inverses_.push_back(w.inverse());
+      }
+      target_of_tet_[t] = shape->second;
+    }
   }
+  const Matrix3d& target_inverse(TetId t) const { return target_inverses_[target_of_tet_[t]]; }
 
   void classify_nodes();
   std::vector<VertexId> free_nodes() const;
@@ -159,18 +218,22 @@ class Smoother {
         if (w != v) visit(w);
   }
 
-  Matrix3d s_matrix(TetId t, VertexId v, const Vector3d& x, int& local) const {
-    std::array<Vector3d, 4> p;
-    for (int i = 0; i < 4; ++i) {
-      const VertexId w = oriented_[t][i];
-      if (w == v) local = i;
-      p[i] = w == v ? x : mesh_.points[w];
-    }
-    return edge_matrix(p) * target_inverse_[t];
+  // S = A W^-1 of tet t at the current positions.
+  Matrix3d s_matrix(TetId t) const {
+    const auto& v = oriented_[t];
+    return edge_matrix({mesh_.points[v[0]], mesh_.points[v[1]], mesh_.points[v[2]], mesh_.points[v[3]]}) *
+           target_inverse(t);
   }
-  double star_objective(VertexId v, const Vector3d& x, double delta) const;
-  Distortion star_derivatives(VertexId v, const Vector3d& x, double delta) const;
-  double choose_delta(VertexId v, double& length, bool& tangled_star) const;
+  // A node's star at its current position, and its mean edge length at the node (the scale of a
+  // sensible step).
+  struct Star {
+    std::span<const StarTet> tets;
+    double mean_edge = 0.0;
+  };
+  Star take_star(VertexId v) const;
+  double star_objective(std::span<const StarTet> star, const Vector3d& d, double delta) const;
+  Distortion star_derivatives(std::span<const StarTet> star, const Vector3d& d, double delta) const;
+  double choose_delta(std::span<const StarTet> star, bool& tangled_star) const;
 
   Placement placement(VertexId v) const;
   Jacobian jacobian(VertexId v, const Placement& at) const;
@@ -187,8 +250,9 @@ class Smoother {
   SmoothingOptions options_;
   VertexTets stars_;
   std::vector<std::array<VertexId, 4>> oriented_;
-  SmoothingTarget target_ = SmoothingTarget::meccano;  // what target_inverse_ holds now
-  std::vector<Matrix3d> target_inverse_;
+  SmoothingTarget target_ = SmoothingTarget::meccano;  // what the W^-1 are for now
+  std::vector<Matrix3d> target_inverses_;  // one per shape of tet
+  std::vector<std::uint32_t> target_of_tet_;
   bool returned_from_fallback_ = false;  // did the smoothing aim at the meccano target again after the fallback?
   std::vector<NodeFreedom> freedom_;
   std::vector<std::vector<int>> hints_;  // per surface and node: the triangle of φ^-1(S) last holding it
@@ -295,49 +359,53 @@ std::vector<std::vector<VertexId>> Smoother::colour(const std::vector<VertexId>&
   return colours;
 }
 
-double Smoother::star_objective(VertexId v, const Vector3d& x, double delta) const {
-  double value = 0.0;
-  int local = 0;
+// The star of v at its current position, in a buffer of the calling thread (nodes are optimised in
+// parallel); valid until the thread takes the next star.
+Smoother::Star Smoother::take_star(VertexId v) const {
+  thread_local std::vector<StarTet> tets;
+  tets.clear();
+  double edges = 0.0;
+  int count = 0;
   for (TetId t : stars_.of(v)) {
-    const Matrix3d s = s_matrix(t, v, x, local);
-    value += raise(regularised_distortion(s.squaredNorm(), s.determinant(), delta), power());
+    int local = 0;
+    for (int i = 0; i < 4; ++i) {
+      const VertexId w = oriented_[t][i];
+      if (w == v) {
+        local = i;
+      } else {
+        edges += (mesh_.points[w] - mesh_.points[v]).norm();
+        ++count;
+      }
+    }
+    tets.push_back(star_tet(s_matrix(t), target_inverse(t), local));
   }
+  return {tets, edges / std::max(count, 1)};
+}
+
+double Smoother::star_objective(std::span<const StarTet> star, const Vector3d& d, double delta) const {
+  double value = 0.0;
+  for (const StarTet& tet : star) value += raise(distortion_at(tet, d, delta), power());
   return value;
 }
 
-Distortion Smoother::star_derivatives(VertexId v, const Vector3d& x, double delta) const {
+Distortion Smoother::star_derivatives(std::span<const StarTet> star, const Vector3d& d, double delta) const {
   Distortion sum;
-  int local = 0;
-  for (TetId t : stars_.of(v)) {
-    const Matrix3d s = s_matrix(t, v, x, local);
-    add_power(distortion_derivatives(s, target_inverse_[t], local, delta), power(), sum);
-  }
+  for (const StarTet& tet : star) add_power(distortion_derivatives(tet, d, delta), power(), sum);
   return sum;
 }
 
-// δ from the node's star, the star's mean edge length at the node (the scale of a sensible step), and
-// whether the star holds an inverted tet.
+// δ from the node's star, and whether the star holds an inverted tet.
 // Escobar et al.'s rule δ = √(ε(ε − σ_min)) when σ_min < ε, with the authors' floor 1e-4 · mean|σ| (their
 // code never lets δ reach 0). Their ε (2.2e-10 on a mesh scaled to radius 10) left the cube example
 // with 5 tets inverted after 100 sweeps: each sat in a local minimum behind S. ε = 1e-3 · mean|σ|
 // smooths the objective where the star is tangled and untangled it in 4 sweeps; on valid stars δ is
 // the floor, so the smoothing itself is unchanged.
-double Smoother::choose_delta(VertexId v, double& length, bool& tangled_star) const {
+double Smoother::choose_delta(std::span<const StarTet> star, bool& tangled_star) const {
   double sigma_min = infinity, sigma_sum = 0.0;
-  int local = 0;
-  const auto star = stars_.of(v);
-  for (TetId t : star) {
-    const double sigma = s_matrix(t, v, mesh_.points[v], local).determinant();
-    sigma_min = std::min(sigma_min, sigma);
-    sigma_sum += std::abs(sigma);
+  for (const StarTet& tet : star) {
+    sigma_min = std::min(sigma_min, tet.sigma0);
+    sigma_sum += std::abs(tet.sigma0);
   }
-  double edges = 0.0;
-  int count = 0;
-  for_each_star_vertex(v, [&](VertexId w) {
-    edges += (mesh_.points[w] - mesh_.points[v]).norm();
-    ++count;
-  });
-  length = edges / std::max(count, 1);
   tangled_star = sigma_min <= 0.0;
   const double scale = sigma_sum / static_cast<double>(std::max<std::size_t>(star.size(), 1));
   // The raised ε is for tangled stars only: on a valid star it would soften the barrier that keeps it
@@ -452,37 +520,38 @@ bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& u
 // (revisiting every node then made the last untangling sweeps cost as much as the first: twice the
 // seconds per tet on faults whose last inverted tets took 20 sweeps).
 bool Smoother::optimise(VertexId v) {
-  double length = 0.0;
+  const auto [star, length] = take_star(v);
   bool tangled_star = false;
-  const double delta = choose_delta(v, length, tangled_star);
+  const double delta = choose_delta(star, tangled_star);
   const Placement start = placement(v);
   Placement at = start;
+  Distortion model = star_derivatives(star, Vector3d::Zero(), delta);
   for (int step = 0, steps = tangled_ ? 2 * options_.newton_steps : options_.newton_steps; step < steps; ++step) {
-    const Distortion star = star_derivatives(v, at.x, delta);
-    const double value = star.value;
+    const double value = model.value;
     const Jacobian j = jacobian(v, at);
-    const Parameters g = j.transpose() * star.gradient;
+    const Parameters g = j.transpose() * model.gradient;
     if (!std::isfinite(value) || g.norm() * length <= 1e-12 * value) break;
-    // Newton direction with the Hessian's eigenvalues made positive (|λ|, bounded away from 0), so the
-    // direction descends even where the objective is not convex.
-    const Eigen::SelfAdjointEigenSolver<Matrix3d> eigen(j.transpose() * star.hessian * j);
-    Parameters magnitudes = eigen.eigenvalues().cwiseAbs();
-    const double floor = std::max(1e-8 * magnitudes.maxCoeff(), std::numeric_limits<double>::min());
-    magnitudes = magnitudes.cwiseMax(floor);
-    Parameters direction =
-        -(eigen.eigenvectors() * (eigen.eigenvectors().transpose() * g).cwiseQuotient(magnitudes));
+    Parameters direction = descent_direction(j.transpose() * model.hessian * j, g, j);
     // At most half the star's edge length per step: the quadratic model means little beyond that.
     const double physical = (j * direction).norm();
     if (physical > 0.5 * length) direction *= 0.5 * length / physical;
     const double slope = g.dot(direction);
+    // The line search evaluates the derivatives too, except after the last step: the next step needs them
+    // where the trial is accepted, and the first trial (the Newton step) mostly is.
+    const bool last = step + 1 == steps;
     Placement trial;
+    Distortion at_trial;
     bool accepted = false;
-    for (double alpha = 1.0; alpha > 1e-6 && !accepted; alpha *= 0.5)
-      accepted = move(v, at, alpha * direction, trial) &&
-                 star_objective(v, trial.x, delta) <= value + 1e-4 * alpha * slope;
+    for (double alpha = 1.0; alpha > 1e-6 && !accepted; alpha *= 0.5) {
+      if (!move(v, at, alpha * direction, trial)) continue;
+      const Vector3d d = trial.x - start.x;
+      at_trial = last ? Distortion{star_objective(star, d, delta)} : star_derivatives(star, d, delta);
+      accepted = at_trial.value <= value + 1e-4 * alpha * slope;
+    }
     if (!accepted) break;
     const double moved = (trial.x - at.x).norm();
     at = trial;
+    model = at_trial;
     if (moved <= 1e-9 * length) break;
   }
   const double moved = (at.x - start.x).norm();
@@ -509,8 +578,7 @@ SweepRecord Smoother::measure() const {
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < count; ++i) {
     const TetId t = active_tets_[i];
-    int local = 0;
-    const Matrix3d s = s_matrix(t, oriented_[t][0], mesh_.points[oriented_[t][0]], local);
+    const Matrix3d s = s_matrix(t);
     const double sigma = s.determinant();
     distortion[i] = sigma > 0.0 ? s.squaredNorm() / (3.0 * std::cbrt(sigma * sigma)) : infinity;
   }
@@ -636,7 +704,8 @@ SmoothingStats Smoother::run() {
 
 Distortion regularised_distortion(const TetPoints& physical, const Matrix3d& target_inverse, int vertex,
                                   double delta) {
-  return distortion_derivatives(edge_matrix(physical) * target_inverse, target_inverse, vertex, delta);
+  return distortion_derivatives(star_tet(edge_matrix(physical) * target_inverse, target_inverse, vertex), Vector3d::Zero(),
+                                delta);
 }
 
 SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, const SmoothingOptions& options) {

@@ -3,10 +3,10 @@
 // synthetic surfaces of tests/data/hard_surfaces that reproduce what makes them hard, each in the box of
 // the benchmarks (its bounding box grown by a tenth of its largest extent E) at l_r = E / divisor.
 //
-// Every result must be a valid mesh (conforming, positively oriented, the box's volume) whose interface
+// Every result must be a valid mesh (conforming, positively oriented, the box's volume, no sliver) whose interface
 // lies on S and is oriented like it, reached at the l_r asked without retries, with the tet count within
 // 30 % of estimate_tets and the interface normals within the targets: area-weighted mean <= 1
-// degree. The max <= 15 degrees is not met on every fault (doc/benchmarks.md); here the max is
+// degree at E/50 (1.5 at E/30). The max <= 15 degrees is not met on every fault (doc/benchmarks.md); here the max is
 // held below the value measured on each case when this test was written, rounded up by a few degrees,
 // so that a change that brings back the chords across creases fails.
 
@@ -15,6 +15,7 @@
 #include <meccano/mesh_io.hpp>
 #include <meccano/msh_measure.hpp>
 #include <meccano/pipeline.hpp>
+#include <meccano/quality.hpp>
 
 #include <scratch_directory.hpp>
 #include <test_surfaces.hpp>
@@ -36,6 +37,10 @@ struct RealCase {
   double divisor;    // l_r = E / divisor
   double max_normal_deviation_deg;
 };
+
+// No sliver: every case measured 7.7-15.7 degrees when this floor was set. Malibu Coast at E/30 once ended
+// at 0.1 degrees: SUS's δ > 0 on valid stars flattened the objective of tets far below their target's size.
+constexpr double minimum_dihedral_deg = 5.0;
 
 void PrintTo(const RealCase& c, std::ostream* os) { *os << c.name; }
 
@@ -60,6 +65,7 @@ TEST_P(RealSurface, IsInsertedValidFaithfulAndAsEstimated) {
 
   const MeshCheckReport check = verify_mesh(result.mesh);
   ASSERT_TRUE(check.ok()) << check.summary();
+  EXPECT_GE(summarize_quality(result.mesh).min_dihedral_deg, minimum_dihedral_deg) << "a sliver SUS did not lift";
   EXPECT_TRUE(result.finer_retries.empty()) << result.finer_retries.front();
   EXPECT_TRUE(result.side_retry.empty()) << result.side_retry;
   EXPECT_EQ(result.smoothing.fallback_sweep, 0) << "the meccano target stalled";
@@ -74,7 +80,8 @@ TEST_P(RealSurface, IsInsertedValidFaithfulAndAsEstimated) {
   EXPECT_LT(a.node_distance_max, 1e-9 * extent) << "an S_M node off S";
   EXPECT_EQ(a.flipped_faces, 0);
   EXPECT_LT(a.hausdorff, 0.25 * options.resolution);
-  EXPECT_LE(a.normal_deviation_mean_deg, 1.0);
+  // The 1 degree is for l_r = E/50; a coarser interface follows S's bends less closely.
+  EXPECT_LE(a.normal_deviation_mean_deg, c.divisor >= 50 ? 1.0 : 1.5);
   EXPECT_LE(a.normal_deviation_max_deg, c.max_normal_deviation_deg);
 }
 
@@ -82,6 +89,7 @@ INSTANTIATE_TEST_SUITE_P(
     FastSubset, RealSurface,
     ::testing::Values(RealCase{"East_Huasna_E50", "CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts", true, 50, 20},
                       RealCase{"Pipes_Canyon_E30", "MJVA-HSLZ-SBMT-Pipes_Canyon_fault_north_extension-CFM5_1000m.ts", true, 30, 36},
+                      RealCase{"Malibu_Coast_E30", "WTRA-SFFS-ANCP-Malibu_Coast_fault_west_steep_alt2-CFM5_1000m.ts", true, 30, 29},
                       RealCase{"creased_E30", hard_surface("creased.obj"), false, 30, 25},
                       RealCase{"low_dip_E30", hard_surface("low_dip.obj"), false, 30, 6},
                       RealCase{"thin_long_E30", hard_surface("thin_long.obj"), false, 30, 3},

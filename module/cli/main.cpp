@@ -89,10 +89,16 @@ Options:
   --fallback-sweeps N      with the meccano target, tets still inverted after N sweeps are untangled
                            towards the equilateral target, and the smoothing then aims at the meccano
                            target again (default 20; 0: never)
+  --improve MODE           after SUS: smooth (default: the nodes of the tets whose equilateral mean
+                           ratio is below 0.35 are optimised again, the worst tet of each star never
+                           getting worse, so a tet SUS left nearly flat is lifted) or none. topology
+                           (flips and insertions) is not available yet
   --threads N              OpenMP threads (default: all cores); the result does not depend on it
   --report FILE.json       timings, counts and quality before and after smoothing (keys: tets, nodes,
                            inverted, quality.before_smoothing / after_smoothing with meccano and
-                           equilateral min, mean, std; min_dihedral_deg; seconds per stage and total)
+                           equilateral min, mean, std, after_smoothing being the result's, after the
+                           improvement; min_dihedral_deg; seconds per stage and total; improvement:
+                           passes, tets below the threshold and smallest quality before and after)
   --histograms FILE.csv    quality histograms before and after smoothing, both measures (plot them
                            with scripts/plot_quality.py)
   --output FILE            the mesh with the 3D group `domain`, the 2D groups xmin, xmax, ymin, ymax,
@@ -192,6 +198,7 @@ struct Options {
   meccano::SideRule side_rule = meccano::SideRule::positive_first;
   double crease_angle = meccano::default_crease_angle;
   meccano::SmoothingOptions smoothing;
+  meccano::Improvement improve = meccano::InsertionOptions{}.improve;
   std::optional<int> threads;
   std::int64_t max_tets = meccano::default_max_tets;
   int finer_retries = meccano::InsertionOptions{}.finer_retries;
@@ -298,6 +305,11 @@ Options parse_options(int argc, char** argv) {
         throw UsageError("--target " + target + ": the targets are meccano and equilateral");
       options.smoothing.target =
           target == "meccano" ? meccano::SmoothingTarget::meccano : meccano::SmoothingTarget::equilateral;
+    } else if (arg == "--improve") {
+      const std::string& mode = value();
+      if (mode == "topology") throw UsageError("--improve topology: flips and insertions are not implemented yet; the modes are smooth and none");
+      if (mode != "smooth" && mode != "none") throw UsageError("--improve " + mode + ": the modes are smooth and none");
+      options.improve = mode == "smooth" ? meccano::Improvement::smooth : meccano::Improvement::none;
     } else if (arg == "--max-sweeps") {
       options.smoothing.max_sweeps = parse_int(arg, value());
       if (options.smoothing.max_sweeps < 1) throw UsageError("--max-sweeps must be at least 1");
@@ -423,6 +435,7 @@ int run(const Options& options) {
   insertion.approximation.side_rule = options.side_rule;
   insertion.projection.crease_angle = options.crease_angle;
   insertion.smoothing = options.smoothing;
+  insertion.improve = options.improve;
   insertion.max_tets = options.max_tets;
   insertion.finer_retries = options.finer_retries;
   // Without a callback the stages build no progress lines at all.

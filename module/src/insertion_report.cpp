@@ -82,6 +82,16 @@ void write_smoothing(JsonWriter& json, const SmoothingStats& s, double seconds) 
   json.key("seconds").value(seconds).end_object();
 }
 
+void write_improvement(JsonWriter& json, const ImprovementStats& s, double seconds) {
+  json.key("improvement").begin_object();
+  json.key("passes").value(s.passes);
+  json.key("tets_below_threshold_before").value(s.tets_below_before).key("tets_below_threshold_after").value(s.tets_below_after);
+  json.key("node_updates").value(s.node_updates).key("nodes_moved").value(s.nodes_moved);
+  json.key("min_equilateral_quality_before").value(s.min_quality_before);
+  json.key("min_equilateral_quality_after").value(s.min_quality_after);
+  json.key("seconds").value(seconds).end_object();
+}
+
 }  // namespace
 
 std::string insertion_report_json(const InsertionResult& result, Stage last_stage) {
@@ -119,12 +129,14 @@ std::string insertion_report_json(const InsertionResult& result, Stage last_stag
   json.key("seconds").begin_object();
   for (int stage = 0; stage <= static_cast<int>(last_stage) && !result.surfaces.empty(); ++stage)
     json.key(stage_keys[stage]).value(stage_seconds[stage]);
+  if (smoothed && result.improvement) json.key("improvement").value(result.improvement_seconds);
   json.key("total").value(result.seconds).end_object();
 
   json.key("surfaces").begin_array();
   for (const SurfaceInsertion& inserted : result.surfaces) write_surface(json, inserted, last_stage);
   json.end_array();
   if (smoothed) write_smoothing(json, result.smoothing, result.smoothing_seconds);
+  if (smoothed && result.improvement) write_improvement(json, *result.improvement, result.improvement_seconds);
   json.end_object();
   return json.str();
 }

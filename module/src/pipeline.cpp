@@ -181,6 +181,17 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
          "); quality min ", last.min_quality, " mean ", last.mean_quality);
   if (!smoothing.untangled()) return result;  // the caller may retry, or reports the failure
   check_stage(result.mesh, "smoothing");
+
+  if (options.improve == Improvement::smooth) {
+    const auto started = std::chrono::steady_clock::now();
+    const ImprovementStats& improved = result.improvement.emplace(improve_worst_tets(result.mesh, projections, options.improvement));
+    result.improvement_seconds = seconds_since(started);
+    report(options, "improvement: ", improved.passes, " passes over the tets below ", options.improvement.threshold,
+           " (", improved.tets_below_before, " before, ", improved.tets_below_after, " after), ", improved.nodes_moved,
+           " of ", improved.node_updates, " node updates moved; smallest quality ", improved.min_quality_before, " -> ",
+           improved.min_quality_after, " (equilateral)");
+    check_stage(result.mesh, "improvement");
+  }
   result.quality_after_smoothing = summarize_quality(result.mesh);
   return result;
 }

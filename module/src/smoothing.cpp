@@ -1,5 +1,7 @@
 #include <meccano/smoothing.hpp>
 
+#include <meccano/improvement.hpp>
+
 #include <meccano/quality.hpp>
 
 #include <Eigen/Dense>
@@ -62,6 +64,7 @@ double regularised_distortion(double frobenius_squared, double sigma, double del
 struct StarTet {
   double n0 = 0.0, beta = 0.0, sigma0 = 0.0;
   Vector3d u = Vector3d::Zero(), w = Vector3d::Zero();
+  double delta = 0.0;  // the regularisation of σ for this update (Smoother::set_deltas)
 
   double frobenius_squared(const Vector3d& d) const { return n0 + 2.0 * d.dot(u) + d.squaredNorm() * beta; }
   double sigma(const Vector3d& d) const { return sigma0 + d.dot(w); }
@@ -72,12 +75,18 @@ StarTet star_tet(const Matrix3d& s, const Matrix3d& target_inverse, int k) {
   return {s.squaredNorm(), b.squaredNorm(), s.determinant(), s * b, cofactor(s) * b};
 }
 
-double distortion_at(const StarTet& tet, const Vector3d& d, double delta) {
-  return regularised_distortion(tet.frobenius_squared(d), tet.sigma(d), delta);
+double distortion_at(const StarTet& tet, const Vector3d& d) {
+  return regularised_distortion(tet.frobenius_squared(d), tet.sigma(d), tet.delta);
+}
+
+// The exact distortion (δ = 0): infinite unless σ > 0.
+double exact_distortion_at(const StarTet& tet, const Vector3d& d) {
+  return regularised_distortion(tet.frobenius_squared(d), tet.sigma(d), 0.0);
 }
 
 // f, ∇f and ∇²f at d (no derivatives where f is infinite).
-Distortion distortion_derivatives(const StarTet& tet, const Vector3d& d, double delta) {
+Distortion distortion_derivatives(const StarTet& tet, const Vector3d& d) {
+  const double delta = tet.delta;
   Distortion f;
   const double n = tet.frobenius_squared(d);
   const double sigma = tet.sigma(d);
@@ -170,6 +179,7 @@ class Smoother {
   }
 
   SmoothingStats run();
+  ImprovementStats improve(const ImprovementOptions& options);
 
  private:
   static Matrix3d equilateral_target() {
@@ -227,13 +237,13 @@ class Smoother {
   // A node's star at its current position, and its mean edge length at the node (the scale of a
   // sensible step).
   struct Star {
-    std::span<const StarTet> tets;
+    std::span<StarTet> tets;
     double mean_edge = 0.0;
   };
   Star take_star(VertexId v) const;
-  double star_objective(std::span<const StarTet> star, const Vector3d& d, double delta) const;
-  Distortion star_derivatives(std::span<const StarTet> star, const Vector3d& d, double delta) const;
-  double choose_delta(std::span<const StarTet> star, bool& tangled_star) const;
+  double star_objective(std::span<const StarTet> star, const Vector3d& d) const;
+  Distortion star_derivatives(std::span<const StarTet> star, const Vector3d& d) const;
+  bool set_deltas(std::span<StarTet> star) const;
 
   Placement placement(VertexId v) const;
   Jacobian jacobian(VertexId v, const Placement& at) const;
@@ -242,8 +252,9 @@ class Smoother {
   bool optimise(VertexId v);
   void store(VertexId v, const Placement& at);
   SweepRecord measure() const;
-  // The exponent p of Σ η*^p: the paper's 1 while tangled, options_.power once a sweep ends untangled.
-  double power() const { return tangled_ ? 1.0 : options_.power; }
+  // The exponent p of Σ η*^p: the paper's 1 while tangled, options_.power once a sweep ends untangled;
+  // the improvement's own.
+  double power() const { return improving_ ? improving_->power : tangled_ ? 1.0 : options_.power; }
 
   TetMesh& mesh_;
   std::span<SurfaceProjection* const> surfaces_;
@@ -262,6 +273,7 @@ class Smoother {
   bool tangled_ = true;               // did the last sweep end with inverted tets (or none ran yet)?
   static constexpr double initial_untangling_epsilon = 1e-3;
   double untangling_epsilon_ = initial_untangling_epsilon;  // ε / mean|σ|, raised while untangling stalls
+  const ImprovementOptions* improving_ = nullptr;  // set while improve() runs
 };
 
 void Smoother::classify_nodes() {
@@ -382,37 +394,46 @@ Smoother::Star Smoother::take_star(VertexId v) const {
   return {tets, edges / std::max(count, 1)};
 }
 
-double Smoother::star_objective(std::span<const StarTet> star, const Vector3d& d, double delta) const {
+double Smoother::star_objective(std::span<const StarTet> star, const Vector3d& d) const {
   double value = 0.0;
-  for (const StarTet& tet : star) value += raise(distortion_at(tet, d, delta), power());
+  for (const StarTet& tet : star) value += raise(distortion_at(tet, d), power());
   return value;
 }
 
-Distortion Smoother::star_derivatives(std::span<const StarTet> star, const Vector3d& d, double delta) const {
+Distortion Smoother::star_derivatives(std::span<const StarTet> star, const Vector3d& d) const {
   Distortion sum;
-  for (const StarTet& tet : star) add_power(distortion_derivatives(tet, d, delta), power(), sum);
+  for (const StarTet& tet : star) add_power(distortion_derivatives(tet, d), power(), sum);
   return sum;
 }
 
-// δ from the node's star, and whether the star holds an inverted tet.
-// Escobar et al.'s rule δ = √(ε(ε − σ_min)) when σ_min < ε, with the authors' floor 1e-4 · mean|σ| (their
-// code never lets δ reach 0). Their ε (2.2e-10 on a mesh scaled to radius 10) left the cube example
-// with 5 tets inverted after 100 sweeps: each sat in a local minimum behind S. ε = 1e-3 · mean|σ|
-// smooths the objective where the star is tangled and untangled it in 4 sweeps; on valid stars δ is
-// the floor, so the smoothing itself is unchanged.
-double Smoother::choose_delta(std::span<const StarTet> star, bool& tangled_star) const {
+// Each tet's δ for the node's update, and whether the star holds an inverted tet.
+// SUS: one δ per star, Escobar et al.'s rule δ = √(ε(ε − σ_min)) when σ_min < ε, with the authors' floor
+// 1e-4 · mean|σ| (their code never lets δ reach 0). Their ε (2.2e-10 on a mesh scaled to radius 10) left
+// the cube example with 5 tets inverted after 100 sweeps: each sat in a local minimum behind S.
+// ε = 1e-3 · mean|σ| smooths the objective where the star is tangled and untangled it in 4 sweeps; on
+// valid stars δ is the floor, so the smoothing itself is unchanged.
+// Improvement: the star's floor exceeds the σ of tets far smaller than their neighbours, whose cost then
+// falls with their size (N / 3δ^(2/3)) however flat they are; so each tet's floor is 1e-4 of the σ of an
+// ideal tet of its own size, (‖S‖²/3)^(3/2), and small tets are seen as well as large ones.
+bool Smoother::set_deltas(std::span<StarTet> star) const {
   double sigma_min = infinity, sigma_sum = 0.0;
   for (const StarTet& tet : star) {
     sigma_min = std::min(sigma_min, tet.sigma0);
     sigma_sum += std::abs(tet.sigma0);
   }
-  tangled_star = sigma_min <= 0.0;
+  const bool tangled = sigma_min <= 0.0;
+  if (improving_) {
+    for (StarTet& tet : star) tet.delta = 1e-4 * tet.n0 / 3.0 * std::sqrt(tet.n0 / 3.0);
+    return tangled;
+  }
   const double scale = sigma_sum / static_cast<double>(std::max<std::size_t>(star.size(), 1));
   // The raised ε is for tangled stars only: on a valid star it would soften the barrier that keeps it
   // valid, and untangling elsewhere would tangle it.
-  const double epsilon = (sigma_min <= 0.0 ? untangling_epsilon_ : initial_untangling_epsilon) * scale;
+  const double epsilon = (tangled ? untangling_epsilon_ : initial_untangling_epsilon) * scale;
   const double untangling = sigma_min < epsilon ? std::sqrt(epsilon * (epsilon - sigma_min)) : 0.0;
-  return std::max(untangling, 1e-4 * scale);
+  const double delta = std::max(untangling, 1e-4 * scale);
+  for (StarTet& tet : star) tet.delta = delta;
+  return tangled;
 }
 
 Placement Smoother::placement(VertexId v) const {
@@ -521,12 +542,19 @@ bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& u
 // seconds per tet on faults whose last inverted tets took 20 sweeps).
 bool Smoother::optimise(VertexId v) {
   const auto [star, length] = take_star(v);
-  bool tangled_star = false;
-  const double delta = choose_delta(star, tangled_star);
+  const bool tangled_star = set_deltas(star);
   const Placement start = placement(v);
   Placement at = start;
-  Distortion model = star_derivatives(star, Vector3d::Zero(), delta);
-  for (int step = 0, steps = tangled_ ? 2 * options_.newton_steps : options_.newton_steps; step < steps; ++step) {
+  Distortion model = star_derivatives(star, Vector3d::Zero());
+  // Improving: the worst exact distortion of the star, which no step may raise.
+  auto worst = [&star](const Vector3d& d) {
+    double largest = 0.0;
+    for (const StarTet& tet : star) largest = std::max(largest, exact_distortion_at(tet, d));
+    return largest;
+  };
+  double worst_at = improving_ ? worst(Vector3d::Zero()) : 0.0;
+  const int steps = improving_ ? improving_->newton_steps : tangled_ ? 2 * options_.newton_steps : options_.newton_steps;
+  for (int step = 0; step < steps; ++step) {
     const double value = model.value;
     const Jacobian j = jacobian(v, at);
     const Parameters g = j.transpose() * model.gradient;
@@ -542,16 +570,19 @@ bool Smoother::optimise(VertexId v) {
     Placement trial;
     Distortion at_trial;
     bool accepted = false;
+    double worst_trial = 0.0;
     for (double alpha = 1.0; alpha > 1e-6 && !accepted; alpha *= 0.5) {
       if (!move(v, at, alpha * direction, trial)) continue;
       const Vector3d d = trial.x - start.x;
-      at_trial = last ? Distortion{star_objective(star, d, delta)} : star_derivatives(star, d, delta);
+      at_trial = last ? Distortion{star_objective(star, d)} : star_derivatives(star, d);
       accepted = at_trial.value <= value + 1e-4 * alpha * slope;
+      if (accepted && improving_) accepted = (worst_trial = worst(d)) <= worst_at;
     }
     if (!accepted) break;
     const double moved = (trial.x - at.x).norm();
     at = trial;
     model = at_trial;
+    worst_at = worst_trial;
     if (moved <= 1e-9 * length) break;
   }
   const double moved = (at.x - start.x).norm();
@@ -700,16 +731,66 @@ SmoothingStats Smoother::run() {
   return stats_;
 }
 
+ImprovementStats Smoother::improve(const ImprovementOptions& options) {
+  improving_ = &options;
+  tangled_ = false;
+  aim_at(SmoothingTarget::equilateral);
+  ImprovementStats stats;
+  std::vector<double> quality(mesh_.tets.size());
+  // Each tet's equilateral mean ratio; the worst tets' free nodes, in vertex order.
+  auto worst_nodes = [&] {
+#pragma omp parallel for schedule(static)
+    for (TetId t = 0; t < mesh_.num_tets(); ++t) quality[t] = mean_ratio_equilateral(oriented_points(mesh_, t));
+    std::vector<VertexId> nodes;
+    for (TetId t = 0; t < mesh_.num_tets(); ++t)
+      if (quality[t] < options.threshold)
+        for (VertexId v : mesh_.tets[t])
+          if (freedom_[v].kind != Freedom::fixed) nodes.push_back(v);
+    std::sort(nodes.begin(), nodes.end());
+    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    return nodes;
+  };
+  auto below_threshold = [&] {
+    return static_cast<std::int64_t>(std::count_if(quality.begin(), quality.end(), [&](double q) { return q < options.threshold; }));
+  };
+  std::vector<VertexId> nodes = worst_nodes();
+  stats.tets_below_before = below_threshold();
+  stats.min_quality_before = quality.empty() ? 0.0 : *std::min_element(quality.begin(), quality.end());
+  while (!nodes.empty() && stats.passes < options.max_passes) {
+    ++stats.passes;
+    std::int64_t moved = 0;
+    for (const auto& group : colour(nodes)) {
+      const auto size = static_cast<std::int64_t>(group.size());
+#pragma omp parallel for schedule(dynamic, 16) reduction(+ : moved)
+      for (std::int64_t i = 0; i < size; ++i) moved += optimise(group[i]);
+    }
+    stats.node_updates += static_cast<std::int64_t>(nodes.size());
+    stats.nodes_moved += moved;
+    nodes = worst_nodes();
+    if (moved == 0) break;
+  }
+  stats.tets_below_after = below_threshold();
+  stats.min_quality_after = quality.empty() ? 0.0 : *std::min_element(quality.begin(), quality.end());
+  improving_ = nullptr;
+  return stats;
+}
+
 }  // namespace
 
 Distortion regularised_distortion(const TetPoints& physical, const Matrix3d& target_inverse, int vertex,
                                   double delta) {
-  return distortion_derivatives(star_tet(edge_matrix(physical) * target_inverse, target_inverse, vertex), Vector3d::Zero(),
-                                delta);
+  StarTet tet = star_tet(edge_matrix(physical) * target_inverse, target_inverse, vertex);
+  tet.delta = delta;
+  return distortion_derivatives(tet, Vector3d::Zero());
 }
 
 SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, const SmoothingOptions& options) {
   return Smoother(mesh, surfaces, options).run();
+}
+
+ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
+                                    const ImprovementOptions& options) {
+  return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral}).improve(options);
 }
 
 }  // namespace meccano

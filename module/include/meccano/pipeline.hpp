@@ -9,6 +9,8 @@
 //             (smoothing.hpp). If tets stay inverted, the insertion is run again with the S_M of the
 //             surfaces next to them on the other side of S (when the side rule allows it); a mesh that
 //             stays tangled is an error, never a result.
+//          Then the worst tets are lifted (improvement.hpp) unless options.improve is none; the quality
+//          after smoothing is that of the result, after the improvement.
 //          A surface whose insertion still fails (V_M cannot be grown within reach of S, S_M cannot be
 //          healed, or the tets next to its S_M stay tangled on both sides) is inserted again, from the
 //          input mesh, at a finer l_r, at most options.finer_retries times, together with the surfaces
@@ -26,6 +28,7 @@
 //          options.max_tets, are InputErrors: an absurdly small l_r fails at once instead of exhausting memory.
 #pragma once
 
+#include <meccano/improvement.hpp>
 #include <meccano/mesh_io.hpp>
 #include <meccano/projection.hpp>
 #include <meccano/quality.hpp>
@@ -38,6 +41,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -45,6 +49,7 @@
 namespace meccano {
 
 enum class Stage { volumetric, approximation, projection, smoothing };
+enum class Improvement { none, smooth };
 
 // Memory per tet while the pipeline runs: the mesh's 53-80 bytes (doc/design.md) plus the stages' working
 // arrays, about 200; the default limit keeps a run below 16 GiB.
@@ -68,6 +73,8 @@ struct InsertionOptions {
   SurfaceApproximationOptions approximation;  // side rule, healing pass limit
   ProjectionOptions projection;               // Floater weights, creases followed
   SmoothingOptions smoothing;                 // SUS mode, target and limits
+  Improvement improve = Improvement::smooth;  // after SUS: lift the worst tets, or not
+  ImprovementOptions improvement;
   int threads = 0;                            // OpenMP threads for this call; 0 = OpenMP's default
   std::int64_t max_tets = default_max_tets;    // refuse when estimate_tets exceeds it
   int finer_retries = 2;                      // times a failing surface may be retried at a finer l_r
@@ -92,7 +99,9 @@ struct InsertionResult {
   SmoothingStats smoothing;
   double smoothing_seconds = 0.0;
   QualitySummary quality_before_smoothing;  // right after projection (tets may be inverted)
-  QualitySummary quality_after_smoothing;
+  std::optional<ImprovementStats> improvement;  // when the improvement ran
+  double improvement_seconds = 0.0;
+  QualitySummary quality_after_smoothing;   // of the result: after SUS and the improvement
   double seconds = 0.0;                     // the whole insertion
   std::int64_t estimated_tets = 0;          // estimate_tets before any refinement, for the l_r asked
   std::string side_retry;  // why the insertion was run again with S_M on the other side (empty if not)

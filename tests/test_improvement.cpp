@@ -1,5 +1,5 @@
-// Lifting the worst tets after SUS (improvement.hpp): slivers made on purpose are lifted, no tet of a
-// star gets worse, box nodes stay on their sides, the result does not depend on the thread count, and
+// Lifting the worst tets after SUS (improvement.hpp): slivers made on purpose are lifted, the equilateral
+// minimum never falls and the meccano one not below min(before, threshold), box nodes stay on their sides, the result does not depend on the thread count, and
 // on real insertions the S_M nodes stay on S (test_smoothing and test_real_surfaces run the pipeline,
 // which improves by default).
 
@@ -61,6 +61,8 @@ TEST(Improvement, LiftsSliversWithoutMakingAnyStarWorse) {
   EXPECT_NEAR(stats.min_quality_before, before.equilateral.min, 1e-12);
   EXPECT_NEAR(stats.min_quality_after, after.equilateral.min, 1e-12);
   EXPECT_GT(after.equilateral.min, 0.3) << "the slivers stayed";
+  const double threshold = ImprovementOptions{}.threshold;
+  EXPECT_GE(after.meccano.min, std::min(before.meccano.min, threshold)) << "the paper's measure was traded away";
   EXPECT_LT(stats.tets_below_after, stats.tets_below_before);
   EXPECT_GT(stats.nodes_moved, 0);
   for (VertexId v = 0; v < mesh.num_vertices(); ++v)
@@ -104,6 +106,8 @@ TEST(Improvement, RunsAfterSmoothingAndKeepsTheInterfaceOnS) {
   ASSERT_TRUE(improved.improvement.has_value());
   EXPECT_NEAR(improved.improvement->min_quality_before, plain.quality_after_smoothing.equilateral.min, 1e-12);
   EXPECT_GE(improved.quality_after_smoothing.equilateral.min, plain.quality_after_smoothing.equilateral.min);
+  EXPECT_GE(improved.quality_after_smoothing.meccano.min,
+            std::min(plain.quality_after_smoothing.meccano.min, options.improvement.threshold));
   EXPECT_TRUE(verify_mesh(improved.mesh, {.physical = true}).ok());
   for (std::size_t s = 0; s < c.surfaces.size(); ++s) {
     const TriangleBVH tree(c.surfaces[s]);

@@ -239,6 +239,7 @@ class Smoother {
   struct Star {
     std::span<StarTet> tets;
     double mean_edge = 0.0;
+    std::span<StarTet> guard;  // improving: the same tets against the meccano target (exact, δ = 0)
   };
   Star take_star(VertexId v) const;
   double star_objective(std::span<const StarTet> star, const Vector3d& d) const;
@@ -274,6 +275,8 @@ class Smoother {
   static constexpr double initial_untangling_epsilon = 1e-3;
   double untangling_epsilon_ = initial_untangling_epsilon;  // ε / mean|σ|, raised while untangling stalls
   const ImprovementOptions* improving_ = nullptr;  // set while improve() runs
+  std::vector<Matrix3d> guard_inverses_;            // improving: the meccano target's W^-1, per shape
+  std::vector<std::uint32_t> guard_of_tet_;
 };
 
 void Smoother::classify_nodes() {
@@ -374,8 +377,9 @@ std::vector<std::vector<VertexId>> Smoother::colour(const std::vector<VertexId>&
 // The star of v at its current position, in a buffer of the calling thread (nodes are optimised in
 // parallel); valid until the thread takes the next star.
 Smoother::Star Smoother::take_star(VertexId v) const {
-  thread_local std::vector<StarTet> tets;
+  thread_local std::vector<StarTet> tets, guard;
   tets.clear();
+  guard.clear();
   double edges = 0.0;
   int count = 0;
   for (TetId t : stars_.of(v)) {
@@ -389,9 +393,15 @@ Smoother::Star Smoother::take_star(VertexId v) const {
         ++count;
       }
     }
-    tets.push_back(star_tet(s_matrix(t), target_inverse(t), local));
+    const auto& p = oriented_[t];
+    const Matrix3d a = edge_matrix({mesh_.points[p[0]], mesh_.points[p[1]], mesh_.points[p[2]], mesh_.points[p[3]]});
+    tets.push_back(star_tet(a * target_inverse(t), target_inverse(t), local));
+    if (improving_) {
+      const Matrix3d& meccano = guard_inverses_[guard_of_tet_[t]];
+      guard.push_back(star_tet(a * meccano, meccano, local));
+    }
   }
-  return {tets, edges / std::max(count, 1)};
+  return {tets, edges / std::max(count, 1), guard};
 }
 
 double Smoother::star_objective(std::span<const StarTet> star, const Vector3d& d) const {
@@ -541,18 +551,22 @@ bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& u
 // (revisiting every node then made the last untangling sweeps cost as much as the first: twice the
 // seconds per tet on faults whose last inverted tets took 20 sweeps).
 bool Smoother::optimise(VertexId v) {
-  const auto [star, length] = take_star(v);
+  const auto [star, length, guard] = take_star(v);
   const bool tangled_star = set_deltas(star);
   const Placement start = placement(v);
   Placement at = start;
   Distortion model = star_derivatives(star, Vector3d::Zero());
-  // Improving: the worst exact distortion of the star, which no step may raise.
-  auto worst = [&star](const Vector3d& d) {
+  // Improving: the star's worst exact distortion towards the equilateral tet, which no step may raise,
+  // and towards the meccano targets, which may rise only up to 1 / threshold (so a star's meccano minimum
+  // either stays or stays above the threshold, and the mesh's meccano minimum cannot fall below
+  // min(before, threshold): the paper's measure is not traded away where it is already poor).
+  auto worst = [](std::span<const StarTet> tets, const Vector3d& d) {
     double largest = 0.0;
-    for (const StarTet& tet : star) largest = std::max(largest, exact_distortion_at(tet, d));
+    for (const StarTet& tet : tets) largest = std::max(largest, exact_distortion_at(tet, d));
     return largest;
   };
-  double worst_at = improving_ ? worst(Vector3d::Zero()) : 0.0;
+  double worst_at = improving_ ? worst(star, Vector3d::Zero()) : 0.0;
+  double guard_at = improving_ ? std::max(worst(guard, Vector3d::Zero()), 1.0 / improving_->threshold) : 0.0;
   const int steps = improving_ ? improving_->newton_steps : tangled_ ? 2 * options_.newton_steps : options_.newton_steps;
   for (int step = 0; step < steps; ++step) {
     const double value = model.value;
@@ -570,19 +584,23 @@ bool Smoother::optimise(VertexId v) {
     Placement trial;
     Distortion at_trial;
     bool accepted = false;
-    double worst_trial = 0.0;
+    double worst_trial = 0.0, guard_trial = 0.0;
     for (double alpha = 1.0; alpha > 1e-6 && !accepted; alpha *= 0.5) {
       if (!move(v, at, alpha * direction, trial)) continue;
       const Vector3d d = trial.x - start.x;
       at_trial = last ? Distortion{star_objective(star, d)} : star_derivatives(star, d);
       accepted = at_trial.value <= value + 1e-4 * alpha * slope;
-      if (accepted && improving_) accepted = (worst_trial = worst(d)) <= worst_at;
+      if (accepted && improving_)
+        accepted = (worst_trial = worst(star, d)) <= worst_at && (guard_trial = worst(guard, d)) <= guard_at;
     }
     if (!accepted) break;
     const double moved = (trial.x - at.x).norm();
     at = trial;
     model = at_trial;
-    worst_at = worst_trial;
+    if (improving_) {
+      worst_at = worst_trial;
+      guard_at = std::max(guard_trial, 1.0 / improving_->threshold);
+    }
     if (moved <= 1e-9 * length) break;
   }
   const double moved = (at.x - start.x).norm();
@@ -734,6 +752,9 @@ SmoothingStats Smoother::run() {
 ImprovementStats Smoother::improve(const ImprovementOptions& options) {
   improving_ = &options;
   tangled_ = false;
+  aim_at(SmoothingTarget::meccano);
+  guard_inverses_ = std::move(target_inverses_);
+  guard_of_tet_ = std::move(target_of_tet_);
   aim_at(SmoothingTarget::equilateral);
   ImprovementStats stats;
   std::vector<double> quality(mesh_.tets.size());
@@ -790,7 +811,7 @@ SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> su
 
 ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
                                     const ImprovementOptions& options) {
-  return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral}).improve(options);
+  return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral}).improve(options);  // improve() sets both targets
 }
 
 }  // namespace meccano

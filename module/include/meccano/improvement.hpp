@@ -9,8 +9,11 @@
 //          give the nodes to optimise; each takes up to `newton_steps` Newton steps on its star's
 //          Σ η^p with p = `power` towards the equilateral tet, δ = 10^-4 of the σ of an ideal tet of each
 //          tet's own size (small tets are seen as well as large ones), and accepts a step only if it lowers
-//          that sum and does not lower the star's smallest exact mean ratio (max-min: the worst tet of a
-//          star never gets worse). Nodes move with the freedom SUS gives them (box nodes in their planes,
+//          that sum, does not lower the star's smallest exact equilateral mean ratio (max-min: the worst
+//          tet of a star never gets worse) and keeps its smallest mean ratio against the meccano
+//          counterparts (the paper's measure) where it is below `threshold`, or at least `threshold`
+//          where it is above. So the mesh's equilateral minimum cannot fall, nor its meccano minimum
+//          below min(before, threshold). Nodes move with the freedom SUS gives them (box nodes in their planes,
 //          S_M nodes on S, rim nodes along the rim, crease nodes along the crease, S_M kept embedded).
 //          Nodes are coloured as in SUS, so the result does not depend on the thread count.
 // Output   the moved mesh, still valid and conforming (no topology changes: tags and the bisection

@@ -80,6 +80,16 @@ TEST(Improvement, LeavesAMeshWithoutBadTetsAlone) {
   EXPECT_EQ(mesh.points, start);
 }
 
+// In band mode only nodes within the band around the surfaces move, as in SUS: with no surface, none.
+TEST(Improvement, MovesOnlyTheBandInBandMode) {
+  TetMesh mesh = mesh_with_slivers();
+  const std::vector<Eigen::Vector3d> start = mesh.points;
+  const ImprovementStats stats = improve_worst_tets(mesh, {}, {.mode = SmoothingMode::band});
+  EXPECT_GT(stats.tets_below_before, 0);
+  EXPECT_EQ(stats.nodes_moved, 0);
+  EXPECT_EQ(mesh.points, start);
+}
+
 TEST(Improvement, GivesTheSameMeshWithOneAndTwoThreads) {
   std::vector<std::vector<Eigen::Vector3d>> results;
   for (int threads : {1, 2}) {

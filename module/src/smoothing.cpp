@@ -758,7 +758,9 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options) {
   aim_at(SmoothingTarget::equilateral);
   ImprovementStats stats;
   std::vector<double> quality(mesh_.tets.size());
-  // Each tet's equilateral mean ratio; the worst tets' free nodes, in vertex order.
+  std::vector<std::uint8_t> movable(mesh_.points.size(), 0);
+  for (VertexId v : free_nodes()) movable[v] = 1;
+  // Each tet's equilateral mean ratio; the worst tets' movable nodes, in vertex order.
   auto worst_nodes = [&] {
 #pragma omp parallel for schedule(static)
     for (TetId t = 0; t < mesh_.num_tets(); ++t) quality[t] = mean_ratio_equilateral(oriented_points(mesh_, t));
@@ -766,7 +768,7 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options) {
     for (TetId t = 0; t < mesh_.num_tets(); ++t)
       if (quality[t] < options.threshold)
         for (VertexId v : mesh_.tets[t])
-          if (freedom_[v].kind != Freedom::fixed) nodes.push_back(v);
+          if (movable[v]) nodes.push_back(v);
     std::sort(nodes.begin(), nodes.end());
     nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
     return nodes;
@@ -811,7 +813,9 @@ SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> su
 
 ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
                                     const ImprovementOptions& options) {
-  return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral}).improve(options);  // improve() sets both targets
+  // improve() sets both targets; the mode and band decide which nodes are free.
+  return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral, .mode = options.mode, .band_rings = options.band_rings})
+      .improve(options);
 }
 
 }  // namespace meccano

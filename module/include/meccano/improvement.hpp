@@ -15,7 +15,8 @@
 //          where it is above. So the mesh's equilateral minimum cannot fall, nor its meccano minimum
 //          below min(before, threshold). Nodes move with the freedom SUS gives them (box nodes in their planes,
 //          S_M nodes on S, rim nodes along the rim, crease nodes along the crease, S_M kept embedded).
-//          Nodes are coloured as in SUS, so the result does not depend on the thread count.
+//          Nodes are coloured as in SUS, so the result does not depend on the thread count. In band mode
+//          only the band's nodes move, as in SUS.
 // Output   the moved mesh, still valid and conforming (no topology changes: tags and the bisection
 //          hierarchy are untouched), its S_M nodes still on S; statistics.
 // Limits   smoothing alone: a tet whose four nodes cannot move (box corners, nodes of two surfaces) or
@@ -24,6 +25,7 @@
 #pragma once
 
 #include <meccano/projection.hpp>
+#include <meccano/smoothing.hpp>
 #include <meccano/tet_mesh.hpp>
 
 #include <cstdint>
@@ -36,6 +38,10 @@ struct ImprovementOptions {
   int max_passes = 10;
   int newton_steps = 8;     // per node and pass
   double power = 8.0;       // p of the star's Σ η^p
+  // Which nodes may move at all, as in SUS: the whole mesh, or a band of `band_rings` edge rings around
+  // the surfaces (the pipeline passes its smoothing's).
+  SmoothingMode mode = SmoothingMode::whole_mesh;
+  int band_rings = 3;
 };
 
 struct ImprovementStats {

@@ -84,7 +84,7 @@ TEST(Improvement, LeavesAMeshWithoutBadTetsAlone) {
 TEST(Improvement, MovesOnlyTheBandInBandMode) {
   TetMesh mesh = mesh_with_slivers();
   const std::vector<Eigen::Vector3d> start = mesh.points;
-  const ImprovementStats stats = improve_worst_tets(mesh, {}, {.mode = SmoothingMode::band});
+  const ImprovementStats stats = improve_worst_tets(mesh, {}, {}, {.mode = SmoothingMode::band});
   EXPECT_GT(stats.tets_below_before, 0);
   EXPECT_EQ(stats.nodes_moved, 0);
   EXPECT_EQ(mesh.points, start);

@@ -184,10 +184,8 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
 
   if (options.improve == Improvement::smooth) {
     const auto started = std::chrono::steady_clock::now();
-    ImprovementOptions improvement = options.improvement;
-    improvement.mode = options.smoothing.mode;
-    improvement.band_rings = options.smoothing.band_rings;
-    const ImprovementStats& improved = result.improvement.emplace(improve_worst_tets(result.mesh, projections, improvement));
+    const ImprovementStats& improved =
+        result.improvement.emplace(improve_worst_tets(result.mesh, projections, options.improvement, options.smoothing));
     result.improvement_seconds = seconds_since(started);
     report(options, "improvement: ", improved.passes, " passes over the tets below ", options.improvement.threshold,
            " (", improved.tets_below_before, " before, ", improved.tets_below_after, " after), ", improved.nodes_moved,

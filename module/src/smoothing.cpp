@@ -228,12 +228,12 @@ class Smoother {
         if (w != v) visit(w);
   }
 
-  // S = A W^-1 of tet t at the current positions.
-  Matrix3d s_matrix(TetId t) const {
+  // A, the edge matrix of tet t at the current positions, and S = A W^-1.
+  Matrix3d physical_edges(TetId t) const {
     const auto& v = oriented_[t];
-    return edge_matrix({mesh_.points[v[0]], mesh_.points[v[1]], mesh_.points[v[2]], mesh_.points[v[3]]}) *
-           target_inverse(t);
+    return edge_matrix({mesh_.points[v[0]], mesh_.points[v[1]], mesh_.points[v[2]], mesh_.points[v[3]]});
   }
+  Matrix3d s_matrix(TetId t) const { return physical_edges(t) * target_inverse(t); }
   // A node's star at its current position, and its mean edge length at the node (the scale of a
   // sensible step).
   struct Star {
@@ -393,8 +393,7 @@ Smoother::Star Smoother::take_star(VertexId v) const {
         ++count;
       }
     }
-    const auto& p = oriented_[t];
-    const Matrix3d a = edge_matrix({mesh_.points[p[0]], mesh_.points[p[1]], mesh_.points[p[2]], mesh_.points[p[3]]});
+    const Matrix3d a = physical_edges(t);
     tets.push_back(star_tet(a * target_inverse(t), target_inverse(t), local));
     if (improving_) {
       const Matrix3d& meccano = guard_inverses_[guard_of_tet_[t]];
@@ -760,10 +759,14 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options) {
   std::vector<double> quality(mesh_.tets.size());
   std::vector<std::uint8_t> movable(mesh_.points.size(), 0);
   for (VertexId v : free_nodes()) movable[v] = 1;
-  // Each tet's equilateral mean ratio; the worst tets' movable nodes, in vertex order.
-  auto worst_nodes = [&] {
+  // The equilateral mean ratio of the given tets (those whose nodes may have moved).
+  auto measure_tets = [&](const std::vector<TetId>& tets) {
+    const auto count = static_cast<std::int64_t>(tets.size());
 #pragma omp parallel for schedule(static)
-    for (TetId t = 0; t < mesh_.num_tets(); ++t) quality[t] = mean_ratio_equilateral(oriented_points(mesh_, t));
+    for (std::int64_t i = 0; i < count; ++i) quality[tets[i]] = mean_ratio_equilateral(oriented_points(mesh_, tets[i]));
+  };
+  // The worst tets' movable nodes, in vertex order.
+  auto worst_nodes = [&] {
     std::vector<VertexId> nodes;
     for (TetId t = 0; t < mesh_.num_tets(); ++t)
       if (quality[t] < options.threshold)
@@ -776,6 +779,9 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options) {
   auto below_threshold = [&] {
     return static_cast<std::int64_t>(std::count_if(quality.begin(), quality.end(), [&](double q) { return q < options.threshold; }));
   };
+  std::vector<TetId> all(mesh_.tets.size());
+  std::iota(all.begin(), all.end(), TetId{0});
+  measure_tets(all);
   std::vector<VertexId> nodes = worst_nodes();
   stats.tets_below_before = below_threshold();
   stats.min_quality_before = quality.empty() ? 0.0 : *std::min_element(quality.begin(), quality.end());
@@ -789,6 +795,11 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options) {
     }
     stats.node_updates += static_cast<std::int64_t>(nodes.size());
     stats.nodes_moved += moved;
+    std::vector<TetId> touched;
+    for (VertexId v : nodes) touched.insert(touched.end(), stars_.of(v).begin(), stars_.of(v).end());
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    measure_tets(touched);
     nodes = worst_nodes();
     if (moved == 0) break;
   }
@@ -812,9 +823,9 @@ SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> su
 }
 
 ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
-                                    const ImprovementOptions& options) {
-  // improve() sets both targets; the mode and band decide which nodes are free.
-  return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral, .mode = options.mode, .band_rings = options.band_rings})
+                                    const ImprovementOptions& options, const SmoothingOptions& sus) {
+  // improve() sets both targets; SUS's mode and band decide which nodes are free.
+  return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})
       .improve(options);
 }
 

@@ -38,10 +38,6 @@ struct ImprovementOptions {
   int max_passes = 10;
   int newton_steps = 8;     // per node and pass
   double power = 8.0;       // p of the star's Σ η^p
-  // Which nodes may move at all, as in SUS: the whole mesh, or a band of `band_rings` edge rings around
-  // the surfaces (the pipeline passes its smoothing's).
-  SmoothingMode mode = SmoothingMode::whole_mesh;
-  int band_rings = 3;
 };
 
 struct ImprovementStats {
@@ -52,7 +48,8 @@ struct ImprovementStats {
   double min_quality_before = 0.0, min_quality_after = 0.0;  // smallest equilateral mean ratio
 };
 
+// `sus` gives the nodes that may move: those SUS moved (its mode and band); its other fields are unused.
 ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
-                                    const ImprovementOptions& options = {});
+                                    const ImprovementOptions& options = {}, const SmoothingOptions& sus = {});
 
 }  // namespace meccano

@@ -9,7 +9,7 @@
 # pipeline goes; about 3 minutes of tests instead of 13 on 2 cores.
 #
 # The subset covers every stage on coarse cases: the readers, validation, geometry, bisection, V_M,
-# S_M, parameterization, projection, smoothing, the writers and the CLI. Left out: the long smoothing
+# S_M, parameterization, projection, smoothing, the improvement (smoothing and flips), the writers and the CLI. Left out: the long smoothing
 # tests (the side retry, band mode, thread counts: minutes each under the sanitizers), the fine cases
 # of the parameterized stage tests (l_r = 1/32, perturbed) and the Gmsh reference mesher (a third-party
 # library that is not instrumented).
@@ -24,7 +24,8 @@ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMECCANO_SANITIZE=ON \
       -DMECCANO_BUILD_SOLVER_DEMO=OFF > "$build.log" 2>&1 || { cat "$build.log"; exit 1; }
 targets=(meccano-immerse test_surface_io test_surface_validation test_surface_geometry_checks test_geometry
          test_bisection test_volumetric_approximation test_surface_approximation test_parameterization
-         test_projection test_smoothing test_quality test_json_writer test_mesh_io test_interfaces test_cli)
+         test_projection test_smoothing test_improvement test_quality test_json_writer test_mesh_io test_interfaces
+         test_cli)
 cmake --build "$build" -j"$jobs" --target "${targets[@]}" >> "$build.log" 2>&1 || { tail -60 "$build.log"; exit 1; }
 echo "sanitized build: ok (log in $build.log)"
 
@@ -37,6 +38,7 @@ unit='SurfaceIo|SurfaceWeld|MshVersions|SurfaceTopology|GeometryChecks|Geometry\
 unit+='|BallCheck|GrowIntoBall|VolumetricApproximation|SurfaceApproximation\.|Parameterization|Projection\.'
 unit+='|Creases|Distortion|QualitySummary|DihedralAngles|HistogramCsv|JsonWriter|MeshIo|SurfaceInterfaces|CliTest'
 unit+='|Smoothing\.(UntanglesAScrambled|UntanglesTowardsTheEquilateral|FallsBackToTheEquilateral)|InsertionOptions\.SurfacesTooClose'
+unit+='|Improvement\.LiftsSlivers|Flips\.(MendSlivers|NeverLower)'
 coarse='(VolumetricOnSurface|SurfaceApproximationOn|ProjectionOn|SmoothingOn)\..*unit_cube_lr16$'
 excluded='ReferenceGmsh'
 if $quick; then

@@ -137,9 +137,9 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --target cube --output " + path("a.msh"),
        "the targets are meccano and equilateral"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --improve harder --output " + path("a.msh"),
-       "--improve harder: the modes are smooth and none"},
-      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --improve topology --output " + path("a.msh"),
-       "--improve topology: flips and insertions are not implemented yet"},
+       "--improve harder: the modes are topology, smooth and none"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --improve-threshold 0 --output " + path("a.msh"),
+       "--improve-threshold must be above 0 and at most 1"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --side up --output " + path("a.msh"),
        "the rules are positive, negative, positive-only and negative-only"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --threads 0 --output " + path("a.msh"),
@@ -202,6 +202,7 @@ TEST_F(CliTest, EverySmoothingSweepHasAProgressLine) {
   EXPECT_EQ(run.output.find("smoothing sweep " + std::to_string(sweeps + 1) + ": "), std::string::npos) << run.output;
   EXPECT_NE(run.output.find(" tets inverted, quality min "), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("improvement: "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(" rounds of flips: "), std::string::npos) << "topology is the default\n" << run.output;
 
   const CliRun quiet = run_cli(arguments + " --quiet");
   ASSERT_EQ(quiet.status, 0) << quiet.output;
@@ -309,7 +310,8 @@ TEST_F(CliTest, FullPipelineWritesAnUntangledMeshAReportAndHistograms) {
   for (const char* key : {"\"tets\"", "\"nodes\"", "\"inverted\": 0", "\"before_smoothing\"", "\"after_smoothing\"",
                           "\"meccano\"", "\"equilateral\"", "\"min\"", "\"mean\"", "\"std\"", "\"min_dihedral_deg\"",
                           "\"seconds\"", "\"smoothing\"", "\"total\"", "\"improvement\"", "\"tets_below_threshold_before\"",
-                          "\"min_equilateral_quality_after\""})
+                          "\"min_equilateral_quality_after\"", "\"operations\"", "\"flips_2_3\"", "\"flips_3_2\"",
+                          "\"flips_4_4\"", "\"edge_removals\"", "\"surface_edge_flips\"", "\"remeshed_tets\""})
     EXPECT_NE(report.find(key), std::string::npos) << key << " missing from\n" << report;
   std::ifstream histogram_file(path("q.csv"));
   std::string header;

@@ -1,9 +1,14 @@
 // Lifting the worst tets after SUS (improvement.hpp): slivers made on purpose are lifted, the equilateral
-// minimum never falls and the meccano one not below min(before, threshold), box nodes stay on their sides, the result does not depend on the thread count, and
-// on real insertions the S_M nodes stay on S (test_smoothing and test_real_surfaces run the pipeline,
-// which improves by default).
+// minimum never falls and the meccano one not below min(before, threshold), box nodes stay on their sides,
+// the result does not depend on the thread count, and on real insertions the S_M nodes stay on S
+// (test_smoothing and test_real_surfaces run the pipeline, which improves by default). Flips: the mesh
+// stays conforming with its box sides tagged, flipped tets leave the bisection hierarchy, and through the
+// pipeline the interface keeps its orientation, S_M's triangle list matches the tagged faces, and no tet
+// has its four vertices on one surface.
 
+#include <meccano/bisection.hpp>
 #include <meccano/cube_meccano.hpp>
+#include <meccano/error.hpp>
 #include <meccano/geometry.hpp>
 #include <meccano/improvement.hpp>
 #include <meccano/mesh_check.hpp>
@@ -17,6 +22,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
+#include <map>
+#include <set>
 
 namespace meccano {
 namespace {
@@ -124,6 +132,124 @@ TEST(Improvement, RunsAfterSmoothingAndKeepsTheInterfaceOnS) {
     for (VertexId v : improved.surfaces[s].projection.nodes)
       ASSERT_LE(std::sqrt(tree.closest_point(improved.mesh.points[v]).squared_distance), 1e-12 * c.box.diagonal());
   }
+}
+
+
+// The box-side faces as (sorted vertices, tag): flips must keep every one.
+std::map<std::array<VertexId, 3>, FaceTag> box_faces(const TetMesh& mesh) {
+  std::map<std::array<VertexId, 3>, FaceTag> faces;
+  for (TetId t = 0; t < mesh.num_tets(); ++t)
+    for (int f = 0; f < 4; ++f)
+      if (mesh.neighbours[t][f] == no_tet) {
+        std::array<VertexId, 3> key{mesh.tets[t][face_vertices[f][0]], mesh.tets[t][face_vertices[f][1]],
+                                    mesh.tets[t][face_vertices[f][2]]};
+        std::sort(key.begin(), key.end());
+        faces.emplace(key, mesh.face_tags[t][f]);
+      }
+  return faces;
+}
+
+TEST(Flips, MendSliversWithoutTouchingTheBoxAndEndTheHierarchyWhereTheyAct) {
+  TetMesh mesh = mesh_with_slivers();
+  const QualitySummary before = summarize_quality(mesh);
+  const auto box_before = box_faces(mesh);
+  const std::vector<Eigen::Vector3d> points = mesh.points;
+  const int tets_before = mesh.num_tets();
+
+  const FlipStats stats = flip_worst_tets(mesh, {});
+  const QualitySummary after = summarize_quality(mesh);
+  const MeshCheckReport check = verify_mesh(mesh, {.physical = true});
+  EXPECT_TRUE(check.ok()) << check.summary();
+  EXPECT_GT(stats.operations(), 0);
+  EXPECT_GT(stats.flips_2_3 + stats.flips_3_2, 0);
+  EXPECT_GT(stats.flips_4_4 + stats.edge_removals, 0);
+  EXPECT_EQ(stats.surface_edge_flips, 0);
+  EXPECT_EQ(mesh.num_tets(), tets_before + stats.tets_created - stats.tets_removed);
+  EXPECT_GT(after.equilateral.min, before.equilateral.min);
+  EXPECT_EQ(mesh.points, points) << "flips move no node";
+  EXPECT_EQ(box_faces(mesh), box_before);
+
+  std::int64_t remeshed = 0;
+  for (TetId t = 0; t < mesh.num_tets(); ++t) remeshed += !mesh.bisectable(t);
+  EXPECT_GT(remeshed, 0);
+  EXPECT_LE(remeshed, stats.tets_created);
+  const auto first_remeshed = std::find_if(mesh.kinds.begin(), mesh.kinds.end(), [](TetKind k) { return !k.bisectable(); });
+  const TetId t = static_cast<TetId>(first_remeshed - mesh.kinds.begin());
+  EXPECT_EQ(mesh.level(t), -1);
+  const std::vector<TetId> marked{t};
+  EXPECT_THROW(refine_marked(mesh, marked), MeshingError);
+}
+
+TEST(Flips, NeverLowerTheWorstTetAndAreRepeatable) {
+  TetMesh once = mesh_with_slivers();
+  TetMesh twice = mesh_with_slivers();
+  flip_worst_tets(once, {});
+  flip_worst_tets(twice, {});
+  EXPECT_EQ(once.tets, twice.tets);
+  EXPECT_EQ(once.neighbours, twice.neighbours);
+  const double min_once = summarize_quality(once).equilateral.min;
+  flip_worst_tets(once, {});
+  EXPECT_GE(summarize_quality(once).equilateral.min, min_once);
+  EXPECT_TRUE(verify_mesh(once, {.physical = true}).ok());
+}
+
+// Smoothing and flips alternate (with a threshold above the default, for more flips); the pipeline's interface keeps its orientation (every face's normal on
+// the side of S's), S_M's triangle list is the tagged faces, and no tet lies on one surface.
+TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
+  std::int64_t surface_edge_flips = 0;
+  for (const auto& c : testing::surface_cases(16, true)) {
+    if (!c.name.ends_with("_perturbed_lr24")) continue;  // irregular S_M: the most flips
+    SCOPED_TRACE(c.name);
+    InsertionOptions options;
+    options.resolution = c.resolution;
+    options.improve = Improvement::smooth;
+    const InsertionResult smoothed = insert_surfaces(make_cube_meccano(c.box, 0), c.surfaces, options);
+    options.improve = Improvement::topology;
+    options.improvement.threshold = 0.5;  // more flips than the default gives on smooth surfaces
+    const InsertionResult flipped = insert_surfaces(make_cube_meccano(c.box, 0), c.surfaces, options);
+    ASSERT_TRUE(flipped.improvement.has_value());
+    surface_edge_flips += flipped.improvement->flips.surface_edge_flips;
+    std::cerr << c.name << " ops " << flipped.improvement->flips.operations() << " sflips " << flipped.improvement->flips.surface_edge_flips << "\n";
+    const MeshCheckReport check = verify_mesh(flipped.mesh, {.physical = true});
+    ASSERT_TRUE(check.ok()) << check.summary();
+    EXPECT_GE(flipped.quality_after_smoothing.equilateral.min, smoothed.improvement->min_quality_before);
+    EXPECT_EQ(flipped.improvement->remeshed_tets,
+              std::count_if(flipped.mesh.kinds.begin(), flipped.mesh.kinds.end(), [](TetKind k) { return !k.bisectable(); }));
+
+    const std::vector<SurfaceInterface> interfaces = surface_interfaces(flipped);
+    ASSERT_EQ(interfaces.size(), c.surfaces.size());
+    for (std::size_t s = 0; s < c.surfaces.size(); ++s) {
+      const TriangleSurface& surface = c.surfaces[s];
+      const TriangleBVH tree(surface);
+      const SurfaceProjection& projection = flipped.surfaces[s].projection;
+      std::set<std::array<VertexId, 3>> listed, tagged;
+      for (const auto& triangle : projection.triangles) {
+        std::array<VertexId, 3> key{projection.nodes[triangle[0]], projection.nodes[triangle[1]], projection.nodes[triangle[2]]};
+        std::sort(key.begin(), key.end());
+        listed.insert(key);
+      }
+      for (const InterfaceFace& face : interfaces[s].faces) {
+        std::array<VertexId, 3> key = face.vertices;
+        std::sort(key.begin(), key.end());
+        tagged.insert(key);
+        const Eigen::Vector3d centroid = (flipped.mesh.points[face.vertices[0]] + flipped.mesh.points[face.vertices[1]] +
+                                          flipped.mesh.points[face.vertices[2]]) / 3.0;
+        const auto& t = surface.triangles[tree.closest_point(centroid).triangle];
+        const Eigen::Vector3d normal_of_s =
+            (surface.points[t[1]] - surface.points[t[0]]).cross(surface.points[t[2]] - surface.points[t[0]]);
+        ASSERT_GT(face.normal.dot(normal_of_s), 0.0) << "an interface face turned against S";
+      }
+      EXPECT_EQ(listed, tagged);
+      for (VertexId v : projection.nodes)
+        ASSERT_LE(std::sqrt(tree.closest_point(flipped.mesh.points[v]).squared_distance), 1e-12 * c.box.diagonal());
+      std::vector<std::uint8_t> on_surface(flipped.mesh.points.size(), 0);
+      for (VertexId v : projection.nodes) on_surface[v] = 1;
+      for (const auto& tet : flipped.mesh.tets)
+        ASSERT_FALSE(on_surface[tet[0]] && on_surface[tet[1]] && on_surface[tet[2]] && on_surface[tet[3]])
+            << "a tet has its four vertices on one surface";
+    }
+  }
+  EXPECT_GT(surface_edge_flips, 0) << "no case flipped an edge inside S_M: that path went untested";
 }
 
 }  // namespace

@@ -89,16 +89,21 @@ Options:
   --fallback-sweeps N      with the meccano target, tets still inverted after N sweeps are untangled
                            towards the equilateral target, and the smoothing then aims at the meccano
                            target again (default 20; 0: never)
-  --improve MODE           after SUS: smooth (default: the nodes of the tets whose equilateral mean
-                           ratio is below 0.35 are optimised again, the worst tet of each star never
-                           getting worse, so a tet SUS left nearly flat is lifted) or none. topology
-                           (flips and insertions) is not available yet
+  --improve MODE           after SUS, the tets whose equilateral mean ratio is below the threshold:
+                           topology (default): their nodes are optimised again (the worst tet of each
+                           star never getting worse) in rounds with 2-3 flips and edge removals (3-2,
+                           4-4 and larger rings, and edge flips inside the interface where S allows
+                           them); tets made by a flip leave the bisection hierarchy. smooth: the node
+                           optimisation alone. none: SUS's mesh as it is
+  --improve-threshold Q    the equilateral mean ratio below which a tet is improved (default 0.35;
+                           higher costs more time)
   --threads N              OpenMP threads (default: all cores); the result does not depend on it
   --report FILE.json       timings, counts and quality before and after smoothing (keys: tets, nodes,
                            inverted, quality.before_smoothing / after_smoothing with meccano and
                            equilateral min, mean, std, after_smoothing being the result's, after the
                            improvement; min_dihedral_deg; seconds per stage and total; improvement:
-                           passes, tets below the threshold and smallest quality before and after)
+                           passes, tets below the threshold and smallest quality before and after,
+                           rounds, operations by kind, tets removed and created, remeshed_tets)
   --histograms FILE.csv    quality histograms before and after smoothing, both measures (plot them
                            with scripts/plot_quality.py)
   --output FILE            the mesh with the 3D group `domain`, the 2D groups xmin, xmax, ymin, ymax,
@@ -199,6 +204,7 @@ struct Options {
   double crease_angle = meccano::default_crease_angle;
   meccano::SmoothingOptions smoothing;
   meccano::Improvement improve = meccano::InsertionOptions{}.improve;
+  double improve_threshold = meccano::ImprovementOptions{}.threshold;
   std::optional<int> threads;
   std::int64_t max_tets = meccano::default_max_tets;
   int finer_retries = meccano::InsertionOptions{}.finer_retries;
@@ -307,9 +313,14 @@ Options parse_options(int argc, char** argv) {
           target == "meccano" ? meccano::SmoothingTarget::meccano : meccano::SmoothingTarget::equilateral;
     } else if (arg == "--improve") {
       const std::string& mode = value();
-      if (mode == "topology") throw UsageError("--improve topology: flips and insertions are not implemented yet; the modes are smooth and none");
-      if (mode != "smooth" && mode != "none") throw UsageError("--improve " + mode + ": the modes are smooth and none");
-      options.improve = mode == "smooth" ? meccano::Improvement::smooth : meccano::Improvement::none;
+      if (mode == "topology") options.improve = meccano::Improvement::topology;
+      else if (mode == "smooth") options.improve = meccano::Improvement::smooth;
+      else if (mode == "none") options.improve = meccano::Improvement::none;
+      else throw UsageError("--improve " + mode + ": the modes are topology, smooth and none");
+    } else if (arg == "--improve-threshold") {
+      options.improve_threshold = parse_numbers(arg, value(), 1)[0];
+      if (!(options.improve_threshold > 0.0 && options.improve_threshold <= 1.0))
+        throw UsageError("--improve-threshold must be above 0 and at most 1");
     } else if (arg == "--max-sweeps") {
       options.smoothing.max_sweeps = parse_int(arg, value());
       if (options.smoothing.max_sweeps < 1) throw UsageError("--max-sweeps must be at least 1");
@@ -436,6 +447,7 @@ int run(const Options& options) {
   insertion.projection.crease_angle = options.crease_angle;
   insertion.smoothing = options.smoothing;
   insertion.improve = options.improve;
+  insertion.improvement.threshold = options.improve_threshold;
   insertion.max_tets = options.max_tets;
   insertion.finer_retries = options.finer_retries;
   // Without a callback the stages build no progress lines at all.

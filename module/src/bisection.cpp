@@ -41,6 +41,10 @@ class Bisector {
       const VertexId a = mesh_.tets[t][0];
       const VertexId b = mesh_.tets[t][1];
       const int size = collect_patch(t, a, b, patch);
+      for (int i = 0; i < size; ++i)
+        if (!mesh_.bisectable(patch[i]))
+          throw MeshingError("tet " + std::to_string(patch[i]) +
+                             " was made by a topological operation and is not part of the bisection hierarchy");
       const auto incompatible = std::find_if(patch.begin(), patch.begin() + size, [&](TetId p) {
         const auto& v = mesh_.tets[p];
         return !((v[0] == a && v[1] == b) || (v[0] == b && v[1] == a));

@@ -109,7 +109,7 @@ void write_vtu(const TetMesh& mesh, const MeshGroups& groups, const std::string&
 #pragma omp parallel for schedule(static)
   for (TetId t = 0; t < mesh.num_tets(); ++t) {
     const TetPoints p = oriented_points(mesh, t);
-    meccano_quality[t] = mean_ratio_relative(p, oriented_computational_points(mesh, t));
+    meccano_quality[t] = mean_ratio_meccano(mesh, t);
     equilateral_quality[t] = mean_ratio_equilateral(p);
   }
   const std::int64_t tets = mesh_io::group_tet_count(groups);

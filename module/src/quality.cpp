@@ -102,7 +102,7 @@ struct QualityAccumulator {
       return;
     }
     // Clamped because rounding may flip the sign of a nearly flat tet's determinant.
-    add_quality(std::max(0.0, mean_ratio_relative(p, oriented_computational_points(mesh, t))),
+    add_quality(std::max(0.0, mean_ratio_meccano(mesh, t)),
                 std::max(0.0, mean_ratio_equilateral(p)));
     for (double cosine : dihedral_cosines(p)) {
       largest_cosine = std::max(largest_cosine, cosine);
@@ -188,6 +188,11 @@ TetPoints oriented_computational_points(const TetMesh& mesh, TetId t) {
   const MeccanoGrid& m = mesh.meccano;
   return {m.to_physical(mesh.grid[v[0]]), m.to_physical(mesh.grid[v[1]]), m.to_physical(mesh.grid[v[2]]),
           m.to_physical(mesh.grid[v[3]])};
+}
+
+double mean_ratio_meccano(const TetMesh& mesh, TetId t) {
+  const TetPoints p = oriented_points(mesh, t);
+  return mesh.bisectable(t) ? mean_ratio_relative(p, oriented_computational_points(mesh, t)) : mean_ratio_equilateral(p);
 }
 
 QualitySummary summarize_quality(const TetMesh& mesh, int histogram_bins) {

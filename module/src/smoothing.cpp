@@ -12,6 +12,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 
 namespace meccano {
 namespace {
@@ -200,7 +201,17 @@ class Smoother {
       return;
     }
     std::map<std::array<std::int64_t, 9>, std::uint32_t> shape_index;
+    // A remeshed tet has no meccano counterpart: the equilateral tet is its target.
+    std::optional<std::uint32_t> equilateral_shape;
     for (TetId t = 0; t < mesh_.num_tets(); ++t) {
+      if (!mesh_.bisectable(t)) {
+        if (!equilateral_shape) {
+          equilateral_shape = static_cast<std::uint32_t>(target_inverses_.size());
+          target_inverses_.push_back(equilateral_target().inverse());
+        }
+        target_of_tet_[t] = *equilateral_shape;
+        continue;
+      }
       const auto& v = oriented_[t];
       std::array<std::int64_t, 9> edges;
       for (int k = 0; k < 3; ++k)
@@ -823,10 +834,30 @@ SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> su
 }
 
 ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
-                                    const ImprovementOptions& options, const SmoothingOptions& sus) {
-  // improve() sets both targets; SUS's mode and band decide which nodes are free.
-  return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})
-      .improve(options);
+                                    const ImprovementOptions& options, const SmoothingOptions& sus,
+                                    std::span<TetRegion* const> regions) {
+  // improve() sets both targets; SUS's mode and band decide which nodes are free. A flip changes the
+  // stars, so each round smooths with a Smoother built afresh.
+  auto smooth = [&] {
+    return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})
+        .improve(options);
+  };
+  ImprovementStats stats = smooth();
+  if (!options.topology) return stats;
+  for (int round = 0; round < options.rounds; ++round) {
+    const FlipStats flips = flip_worst_tets(mesh, surfaces, regions, options);
+    if (flips.operations() == 0) break;
+    ++stats.rounds;
+    stats.flips += flips;
+    const ImprovementStats smoothed = smooth();
+    stats.passes += smoothed.passes;
+    stats.node_updates += smoothed.node_updates;
+    stats.nodes_moved += smoothed.nodes_moved;
+    stats.tets_below_after = smoothed.tets_below_after;
+    stats.min_quality_after = smoothed.min_quality_after;
+  }
+  for (TetId t = 0; t < mesh.num_tets(); ++t) stats.remeshed_tets += !mesh.bisectable(t);
+  return stats;
 }
 
 }  // namespace meccano

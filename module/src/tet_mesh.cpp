@@ -66,6 +66,7 @@ double TetMesh::longest_edge(TetId t) const {
 }
 
 int TetMesh::level(TetId t) const {
+  if (!bisectable(t)) return -1;
   const GridPoint& a = grid[tets[t][0]];
   const GridPoint& b = grid[tets[t][1]];
   std::int64_t squared = 0;

@@ -49,7 +49,7 @@
 namespace meccano {
 
 enum class Stage { volumetric, approximation, projection, smoothing };
-enum class Improvement { none, smooth };
+enum class Improvement { none, smooth, topology };
 
 // Memory per tet while the pipeline runs: the mesh's 53-80 bytes (doc/design.md) plus the stages' working
 // arrays, about 200; the default limit keeps a run below 16 GiB.
@@ -73,8 +73,10 @@ struct InsertionOptions {
   SurfaceApproximationOptions approximation;  // side rule, healing pass limit
   ProjectionOptions projection;               // Floater weights, creases followed
   SmoothingOptions smoothing;                 // SUS mode, target and limits
-  Improvement improve = Improvement::smooth;  // after SUS: lift the worst tets, or not
-  ImprovementOptions improvement;
+  // After SUS: lift the worst tets by smoothing and flips (topology), by smoothing alone (smooth: keeps
+  // every tet in the bisection hierarchy, for callers that refine the result further), or not at all.
+  Improvement improve = Improvement::topology;
+  ImprovementOptions improvement;            // its `topology` is set from `improve`
   int threads = 0;                            // OpenMP threads for this call; 0 = OpenMP's default
   std::int64_t max_tets = default_max_tets;    // refuse when estimate_tets exceeds it
   int finer_retries = 2;                      // times a failing surface may be retried at a finer l_r

@@ -38,6 +38,9 @@ std::array<double, 6> dihedral_angles_deg(const TetPoints& p);
 // counterpart (q = 1) even when the meccano cells are not cubes.
 TetPoints oriented_points(const TetMesh& mesh, TetId t);
 TetPoints oriented_computational_points(const TetMesh& mesh, TetId t);
+// The paper's measure of tet t: the mean ratio against its meccano counterpart, or against the
+// equilateral tet for a remeshed tet (TetKind::bisectable), which has no counterpart.
+double mean_ratio_meccano(const TetMesh& mesh, TetId t);
 
 // A tet is inverted when its physical volume, in its positive orientation, is not positive (flat counts).
 bool is_inverted(const TetMesh& mesh, TetId t);

@@ -7,7 +7,9 @@
 //               dyadic, so midpoints stay exact, and equal positions hash equal.
 // Tets carry:
 //   - `tets`: the 4 vertices in Kossaczky order (v0-v1 is the refinement edge);
-//   - `kinds`: the Kossaczky type 0/1/2 and whether that vertex order is negatively oriented;
+//   - `kinds`: the Kossaczky type 0/1/2 and whether that vertex order is negatively oriented; or, for a
+//              tet made by a topological operation of the improvement stage (improvement.hpp), that it is
+//              no longer a Kossaczky simplex and may not be bisected (TetKind::bisectable);
 //   - `neighbours`: the tet across face i (face i is opposite vertex i), or no_tet on the box boundary;
 //   - `face_tags`: a tag per local face (box side, interface, or none), kept through refinement.
 //
@@ -55,14 +57,19 @@ const char* box_side_name(BoxSide side);  // "xmin", ..., "zmax"
 // points out of a positively oriented tet.
 inline constexpr std::array<std::array<int, 3>, 4> face_vertices{{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
 
-// Kossaczky type in bits 0-1, orientation flag in bit 2.
+// Kossaczky type in bits 0-1, orientation flag in bit 2, bit 3 set for a remeshed tet.
 struct TetKind {
   std::uint8_t bits = 0;
   int type() const { return bits & 3; }
   bool negative() const { return (bits & 4) != 0; }
+  // False for a tet made by a flip or edge removal: it is not a simplex of the bisection hierarchy, so it has
+  // no refinement edge, type, level or meccano counterpart, and bisection refuses it.
+  bool bisectable() const { return (bits & 8) == 0; }
   static TetKind make(int type, bool negative) {
     return {static_cast<std::uint8_t>(type | (negative ? 4 : 0))};
   }
+  // A remeshed tet, its vertices stored in positive orientation.
+  static TetKind remeshed() { return {8}; }
 };
 
 // The affine map from computational to physical coordinates of the undeformed meccano:
@@ -115,8 +122,9 @@ struct TetMesh {
   double longest_edge(TetId t) const;
   // Bisection level: 0 for the Kuhn tets of a meccano cell, +1 per bisection. Read off the computational
   // length of the refinement edge (a cube diagonal, face diagonal or cube edge of a cube 2^-k cells wide
-  // at levels 3k, 3k+1, 3k+2), so it needs no stored history.
+  // at levels 3k, 3k+1, 3k+2), so it needs no stored history. -1 for a remeshed tet.
   int level(TetId t) const;
+  bool bisectable(TetId t) const { return kinds[t].bisectable(); }
   // Index (0..3) of the face of `t` shared with `neighbour`, or -1.
   int face_towards(TetId t, TetId neighbour) const;
 };

@@ -1,0 +1,504 @@
+// The topological half of the improvement stage: 2-3 flips and edge removal (improvement.hpp).
+#include <meccano/error.hpp>
+#include <meccano/improvement.hpp>
+#include <meccano/quality.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace meccano {
+namespace {
+
+using Tet = std::array<VertexId, 4>;
+constexpr double unacceptable = -std::numeric_limits<double>::infinity();
+
+// True when `to` is an even permutation of `from` (same vertices): the same orientation.
+bool same_orientation(Tet from, const Tet& to) {
+  bool even = true;
+  for (int i = 0; i < 4; ++i) {
+    if (from[i] == to[i]) continue;
+    const auto j = std::find(from.begin() + i + 1, from.end(), to[i]) - from.begin();
+    std::swap(from[i], from[j]);
+    even = !even;
+  }
+  return even;
+}
+
+// Some tets and the positively oriented tets that would replace them, filling the same cavity.
+// A face of the boundary of the tets a flip replaces.
+struct BoundaryFace {
+  std::array<VertexId, 3> key;  // sorted vertices
+  TetId owner;                  // the removed tet behind it
+  TetId neighbour;              // the tet in front, or no_tet
+  int neighbour_face;           // the face's index in `neighbour`
+  FaceTag tag;
+};
+
+// Two S_M triangles exchanged for two others over the same four nodes (node indices of the surface).
+struct SurfaceFlip {
+  int surface;
+  std::array<std::array<int, 3>, 2> removed;  // sorted
+  std::array<std::array<int, 3>, 2> created;  // oriented like S
+};
+
+struct Retriangulation {
+  std::vector<TetId> removed;
+  std::vector<Tet> created;
+  std::vector<TetId> flag_parent;  // per created tet: the removed tet whose region flags it takes by default
+  double worst_removed = 0.0;      // the smallest quality among `removed`
+  double worst_created = unacceptable;
+  // An edge removal inside S_M: the faces of `created` that become interface faces, and S_M's change.
+  std::vector<std::pair<std::array<VertexId, 3>, FaceTag>> tagged_faces;
+  std::optional<SurfaceFlip> surface_flip;
+};
+
+class Flipper {
+ public:
+  Flipper(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, std::span<TetRegion* const> regions,
+          const ImprovementOptions& options)
+      : mesh_(mesh), surfaces_(surfaces), regions_(regions), options_(options), surface_of_(mesh.points.size(), -1),
+        node_index_(mesh.points.size(), -1) {
+    for (std::size_t s = 0; s < surfaces.size(); ++s)
+      for (std::size_t i = 0; i < surfaces[s]->nodes.size(); ++i) {
+        surface_of_[surfaces[s]->nodes[i]] = static_cast<int>(s);
+        node_index_[surfaces[s]->nodes[i]] = static_cast<int>(i);
+      }
+    for (const TetRegion* region : regions)
+      if (region->size() != mesh.tets.size()) throw std::invalid_argument("flip_worst_tets: a region's size is not the tet count");
+  }
+
+  FlipStats run() {
+    for (int pass = 0; pass < options_.max_flip_passes; ++pass) {
+      const std::int64_t before = stats_.operations();
+      for (const auto& [quality, t] : worst_tets()) improve(t);
+      if (stats_.operations() == before) break;
+    }
+    compact();
+    return stats_;
+  }
+
+ private:
+  // The cube of the equilateral mean ratio of a positively ordered tet, 15552 V² / (Σ l²)³, negative when
+  // inverted: the same order as the mean ratio, without its cube root (flips only compare qualities).
+  double quality(const Tet& tet) const {
+    const TetPoints p{mesh_.points[tet[0]], mesh_.points[tet[1]], mesh_.points[tet[2]], mesh_.points[tet[3]]};
+    double sum_squared_edges = 0.0;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) sum_squared_edges += (p[i] - p[j]).squaredNorm();
+    const double volume = signed_volume(p[0], p[1], p[2], p[3]);
+    const double cubed = 15552.0 * volume * std::abs(volume) / (sum_squared_edges * sum_squared_edges * sum_squared_edges);
+    return std::isfinite(cubed) ? cubed : unacceptable;
+  }
+  // A new tet's quality, unacceptable when its four vertices lie on one surface (a fault solver cannot
+  // use such a tet).
+  double new_tet_quality(const Tet& tet) const {
+    const int surface = surface_of_[tet[0]];
+    if (surface >= 0 && surface_of_[tet[1]] == surface && surface_of_[tet[2]] == surface && surface_of_[tet[3]] == surface)
+      return unacceptable;
+    return quality(tet);
+  }
+
+  // The live tets below the threshold, worst first (ties by index: a fixed order).
+  std::vector<std::pair<double, TetId>> worst_tets() const {
+    std::vector<std::pair<double, TetId>> worst;
+    for (TetId t = 0; t < mesh_.num_tets(); ++t) {
+      if (dead(t)) continue;
+      const double q = quality(mesh_.oriented_tet(t));
+      if (q < cubed_threshold()) worst.emplace_back(q, t);
+    }
+    std::sort(worst.begin(), worst.end());
+    return worst;
+  }
+
+  bool dead(TetId t) const { return mesh_.tets[t][0] < 0; }
+  // The threshold in the measure of quality().
+  double cubed_threshold() const { return options_.threshold * options_.threshold * options_.threshold; }
+
+  static int local_index(const Tet& tet, VertexId v) {
+    return static_cast<int>(std::find(tet.begin(), tet.end(), v) - tet.begin());
+  }
+
+  // Tries every flip and edge removal that removes t; applies the one whose worst new tet is best, if it
+  // beats the worst tet it removes.
+  void improve(TetId t) {
+    if (dead(t)) return;
+    const double q = quality(mesh_.oriented_tet(t));
+    if (q >= cubed_threshold()) return;  // a flip next to it has already mended it
+    std::optional<Retriangulation> best;
+    auto consider = [&](std::optional<Retriangulation> candidate) {
+      if (candidate && candidate->worst_created > candidate->worst_removed &&
+          (!best || candidate->worst_created > best->worst_created))
+        best = std::move(candidate);
+    };
+    const Tet& v = mesh_.tets[t];
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) consider(edge_removal(t, v[i], v[j]));
+    for (int f = 0; f < 4; ++f) consider(flip_2_3(t, f));
+    if (best) apply(*best);
+  }
+
+  // For each created tet, the removed tet whose region flags it takes: the one behind its interface faces
+  // on the cavity's boundary (so that each interface face keeps V_M on the same side, which orients it),
+  // else r.flag_parent. Empty if a created tet's interface faces disagree.
+  std::vector<TetId> flag_parents(const Retriangulation& r, std::span<const BoundaryFace> boundary) const {
+    std::vector<TetId> parents = r.flag_parent;
+    auto same_flags = [&](TetId x, TetId y) {
+      return std::all_of(regions_.begin(), regions_.end(), [&](const TetRegion* region) { return (*region)[x] == (*region)[y]; });
+    };
+    for (std::size_t i = 0; i < r.created.size(); ++i) {
+      bool on_interface = false;
+      for (int f = 0; f < 4; ++f) {
+        const auto key = sorted_face(r.created[i], f);
+        const auto face = std::find_if(boundary.begin(), boundary.end(), [&](const BoundaryFace& b) { return b.key == key; });
+        if (face == boundary.end() || !is_interface_tag(face->tag)) continue;
+        if (on_interface && !same_flags(face->owner, parents[i])) return {};
+        on_interface = true;
+        parents[i] = face->owner;
+      }
+    }
+    return parents;
+  }
+
+  static std::array<VertexId, 3> sorted_face(const Tet& tet, int f) {
+    std::array<VertexId, 3> key{tet[face_vertices[f][0]], tet[face_vertices[f][1]], tet[face_vertices[f][2]]};
+    std::sort(key.begin(), key.end());
+    return key;
+  }
+
+  // The tets around the interior edge (a, b) as a ring T_0..T_{m-1} with ring vertices r_0..r_{m-1},
+  // T_i = (a, b, r_i, r_{i+1}), replaced by the tets (a, r_i, r_k, r_j) and (b, r_i, r_j, r_k) over the
+  // triangles (i < k < j) of the ring polygon's triangulation whose worst tet is best. When (a, b) is an
+  // edge inside S_M, two of the faces around it, (a, b, r_p) and (a, b, r_q), are interface faces: the
+  // triangulation must then hold the diagonal (r_p, r_q), whose faces (a, r_p, r_q) and (b, r_p, r_q)
+  // become the interface there (interface_flip decides whether S_M may take them).
+  std::optional<Retriangulation> edge_removal(TetId t, VertexId a, VertexId b) const {
+    const Tet& first = mesh_.tets[t];
+    std::vector<VertexId> ring;
+    for (VertexId v : first)
+      if (v != a && v != b) ring.push_back(v);
+    Retriangulation r;
+    r.removed.push_back(t);
+    FaceTag interface = no_face_tag;
+    std::vector<int> on_interface;  // ring indices i of the interface faces (a, b, r_i)
+    for (TetId current = t;;) {
+      // Cross the face of T_i opposite r_i, which holds a, b and r_{i+1}.
+      const int i = static_cast<int>(r.removed.size()) - 1;
+      const int face = local_index(mesh_.tets[current], ring[i]);
+      if (const FaceTag tag = mesh_.face_tags[current][face]; tag != no_face_tag) {
+        if (!is_interface_tag(tag) || (interface != no_face_tag && tag != interface) || on_interface.size() == 2)
+          return std::nullopt;
+        interface = tag;
+        on_interface.push_back(i + 1);
+      }
+      const TetId next = mesh_.neighbours[current][face];
+      if (next == no_tet) return std::nullopt;
+      if (next == t) break;
+      if (static_cast<int>(r.removed.size()) == options_.max_ring) return std::nullopt;
+      const VertexId shared = ring.back();
+      for (VertexId v : mesh_.tets[next])
+        if (v != a && v != b && v != shared) ring.push_back(v);
+      r.removed.push_back(next);
+      current = next;
+    }
+    const int m = static_cast<int>(r.removed.size());
+    ring.pop_back();  // r_m is r_0
+    if (on_interface.size() == 1) return std::nullopt;  // a rim edge
+    if (!same_orientation(mesh_.oriented_tet(t), {a, b, ring[0], ring[1]})) std::swap(a, b);
+    // With an interface, start the ring at r_p (a rotation keeps its order): the diagonal is (r_0, r_q).
+    int q = 0;
+    if (!on_interface.empty()) {
+      const int p = on_interface[0] % m;
+      std::rotate(ring.begin(), ring.begin() + p, ring.end());
+      std::rotate(r.removed.begin(), r.removed.begin() + p, r.removed.end());
+      q = (on_interface[1] % m - p + m) % m;
+      if (q < 2 || q > m - 2) return std::nullopt;  // r_p and r_q adjacent: (r_p, r_q) is not a diagonal
+    }
+
+    r.worst_removed = std::numeric_limits<double>::infinity();
+    for (TetId removed : r.removed) r.worst_removed = std::min(r.worst_removed, quality(mesh_.oriented_tet(removed)));
+
+    // best[i][j]: the best worst tet over the triangulations of the sub-polygon r_i..r_j; split[i][j] its
+    // apex. The ring closes with r_m = r_0, so that the sub-polygons r_0..r_q and r_q..r_m split the ring
+    // along the diagonal.
+    ring.push_back(ring[0]);
+    std::vector<std::vector<double>> best(m + 1, std::vector<double>(m + 1, std::numeric_limits<double>::infinity()));
+    std::vector<std::vector<int>> split(m + 1, std::vector<int>(m + 1, -1));
+    auto triangle_quality = [&](int i, int k, int j) {
+      return std::min(new_tet_quality({a, ring[i], ring[k], ring[j]}), new_tet_quality({b, ring[i], ring[j], ring[k]}));
+    };
+    const std::vector<std::pair<int, int>> polygons =
+        q == 0 ? std::vector<std::pair<int, int>>{{0, m - 1}} : std::vector<std::pair<int, int>>{{0, q}, {q, m}};
+    for (const auto& [lo, hi] : polygons)
+      for (int width = 2; width <= hi - lo; ++width)
+        for (int i = lo; i + width <= hi; ++i) {
+          const int j = i + width;
+          best[i][j] = unacceptable;
+          for (int k = i + 1; k < j; ++k) {
+            const double worst = std::min({best[i][k], best[k][j], triangle_quality(i, k, j)});
+            if (worst > best[i][j]) {
+              best[i][j] = worst;
+              split[i][j] = k;
+            }
+          }
+        }
+    r.worst_created = std::numeric_limits<double>::infinity();
+    for (const auto& [lo, hi] : polygons) r.worst_created = std::min(r.worst_created, best[lo][hi]);
+    if (!(r.worst_created > r.worst_removed)) return std::nullopt;
+    if (q != 0) {
+      r.surface_flip = interface_flip(interface_index(interface), a, b, ring[0], ring[q]);
+      if (!r.surface_flip) return std::nullopt;
+      r.tagged_faces = {{sorted_face({a, ring[0], ring[q], b}, 3), interface}, {sorted_face({b, ring[0], ring[q], a}, 3), interface}};
+    }
+    for (const auto& [lo, hi] : polygons) {
+      // The tets over the sub-polygon lo..hi lie where T_lo .. T_{hi-1} were: on one side of S_M.
+      const TetId side = r.removed[lo];
+      std::vector<std::pair<int, int>> pending{{lo, hi}};
+      while (!pending.empty()) {
+        const auto [i, j] = pending.back();
+        pending.pop_back();
+        if (j - i < 2) continue;
+        const int k = split[i][j];
+        r.created.push_back({a, ring[i], ring[k], ring[j]});
+        r.created.push_back({b, ring[i], ring[j], ring[k]});
+        r.flag_parent.insert(r.flag_parent.end(), 2, side);
+        pending.push_back({i, k});
+        pending.push_back({k, j});
+      }
+    }
+    return r;
+  }
+
+  // Whether S_M may exchange its triangles (a, b, p) and (b, a, q) for two triangles over (p, q): the
+  // diagonal must cross (a, b) in P (so S_M stays embedded in P, as step 4 keeps it), and the new
+  // triangles' normals may deviate from S's (at their centroids in P) no more than the old ones' do.
+  // Returns the new triangles as node indices of the surface, oriented like S in P.
+  std::optional<SurfaceFlip> interface_flip(int surface, VertexId a, VertexId b, VertexId p, VertexId q) const {
+    const SurfaceProjection& projection = *surfaces_[surface];
+    const int na = node_index_[a], nb = node_index_[b], np = node_index_[p], nq = node_index_[q];
+    auto uv = [&](int node) { return projection.uv[node]; };
+    auto orient = [&](int x, int y, int z) {
+      const Eigen::Vector2d e = uv(y) - uv(x), f = uv(z) - uv(x);
+      return e.x() * f.y() - e.y() * f.x();
+    };
+    if (!(orient(np, nq, na) * orient(np, nq, nb) < 0.0) || !(orient(na, nb, np) * orient(na, nb, nq) < 0.0))
+      return std::nullopt;
+    auto deviation = [&](int x, int y, int z) {
+      const Eigen::Vector2d centroid = (uv(x) + uv(y) + uv(z)) / 3.0;
+      const Eigen::Matrix<double, 3, 2> tangent = projection.surface->derivative(projection.surface->locate(centroid).triangle);
+      const Eigen::Vector3d normal_of_s = tangent.col(0).cross(tangent.col(1)).normalized();
+      const Eigen::Vector3d& px = mesh_.points[projection.nodes[x]];
+      const Eigen::Vector3d normal = (mesh_.points[projection.nodes[y]] - px).cross(mesh_.points[projection.nodes[z]] - px).normalized();
+      return std::abs(normal.dot(normal_of_s));  // the cosine: larger is better
+    };
+    if (std::min(deviation(np, nq, na), deviation(np, nq, nb)) < std::min(deviation(na, nb, np), deviation(na, nb, nq)))
+      return std::nullopt;
+    SurfaceFlip flip{surface, {}, {}};
+    flip.removed = {sorted_triangle({na, nb, np}), sorted_triangle({na, nb, nq})};
+    flip.created = {std::array<int, 3>{np, nq, na}, std::array<int, 3>{nq, np, nb}};
+    for (auto& triangle : flip.created)
+      if ((orient(triangle[0], triangle[1], triangle[2]) > 0.0) != (projection.orientation > 0)) std::swap(triangle[1], triangle[2]);
+    return flip;
+  }
+
+  static std::array<int, 3> sorted_triangle(std::array<int, 3> triangle) {
+    std::sort(triangle.begin(), triangle.end());
+    return triangle;
+  }
+
+  // Tets t and its neighbour across face f, sharing the untagged face (x, y, z), replaced by the three tets
+  // around the new edge from t's apex to the neighbour's: t's own vertex order with one face vertex
+  // replaced by the neighbour's apex, so that each keeps its orientation.
+  std::optional<Retriangulation> flip_2_3(TetId t, int f) const {
+    const TetId n = mesh_.neighbours[t][f];
+    if (n == no_tet || mesh_.face_tags[t][f] != no_face_tag) return std::nullopt;
+    const Tet& tv = mesh_.tets[t];
+    const Tet& nv = mesh_.tets[n];
+    const VertexId apex = nv[mesh_.face_towards(n, t)];
+    Retriangulation r;
+    r.removed = {t, n};
+    r.worst_removed = std::min(quality(mesh_.oriented_tet(t)), quality(mesh_.oriented_tet(n)));
+    const Tet oriented = mesh_.oriented_tet(t);
+    for (VertexId replaced : tv) {
+      if (replaced == tv[f]) continue;
+      Tet created = oriented;
+      created[local_index(oriented, replaced)] = apex;
+      r.worst_created = r.created.empty() ? new_tet_quality(created) : std::min(r.worst_created, new_tet_quality(created));
+      r.created.push_back(created);
+      r.flag_parent.push_back(t);
+    }
+    return r;
+  }
+
+  // The faces of the cavity's boundary: each with the removed tet behind it and the tet (and its local
+  // face) in front, or no_tet on the box.
+  std::vector<BoundaryFace> cavity_boundary(std::span<const TetId> removed) const {
+    std::vector<BoundaryFace> boundary;
+    for (TetId t : removed)
+      for (int f = 0; f < 4; ++f) {
+        const TetId n = mesh_.neighbours[t][f];
+        if (std::find(removed.begin(), removed.end(), n) != removed.end()) continue;
+        boundary.push_back({sorted_face(mesh_.tets[t], f), t, n, n == no_tet ? -1 : mesh_.face_towards(n, t),
+                            mesh_.face_tags[t][f]});
+      }
+    return boundary;
+  }
+
+  // `count` tet slots: the removed tets' first, then free ones, then new ones. Removed tets left over
+  // become free.
+  std::vector<TetId> take_slots(std::span<const TetId> removed, std::size_t count) {
+    std::vector<TetId> slots(removed.begin(), removed.end());
+    while (slots.size() < count) {
+      if (!free_.empty()) {
+        slots.push_back(free_.back());
+        free_.pop_back();
+        continue;
+      }
+      slots.push_back(mesh_.num_tets());
+      mesh_.tets.emplace_back();
+      mesh_.kinds.emplace_back();
+      mesh_.neighbours.emplace_back();
+      mesh_.face_tags.emplace_back();
+      for (TetRegion* region : regions_) region->push_back(0);
+    }
+    for (std::size_t i = count; i < slots.size(); ++i) {
+      mesh_.tets[slots[i]] = {-1, -1, -1, -1};
+      mesh_.neighbours[slots[i]] = {no_tet, no_tet, no_tet, no_tet};
+      free_.push_back(slots[i]);
+    }
+    slots.resize(count);
+    return slots;
+  }
+
+  // Replaces r.removed by r.created, unless the region flags cannot follow (flag_parents): the created
+  // tets inherit the tags and neighbours of the cavity's boundary faces and are each other's neighbours
+  // across the faces inside it, tagged as r.tagged_faces says; S_M takes r.surface_flip.
+  void apply(const Retriangulation& r) {
+    const std::vector<BoundaryFace> boundary = cavity_boundary(r.removed);
+    const std::vector<TetId> parents = flag_parents(r, boundary);
+    if (parents.empty()) return;
+    std::vector<std::vector<std::uint8_t>> flags(regions_.size());
+    for (std::size_t k = 0; k < regions_.size(); ++k)
+      for (TetId parent : parents) flags[k].push_back((*regions_[k])[parent]);
+
+    const std::vector<TetId> slots = take_slots(r.removed, r.created.size());
+    for (std::size_t i = 0; i < slots.size(); ++i) {
+      mesh_.tets[slots[i]] = r.created[i];
+      mesh_.kinds[slots[i]] = TetKind::remeshed();
+      for (std::size_t k = 0; k < regions_.size(); ++k) (*regions_[k])[slots[i]] = flags[k][i];
+    }
+    std::size_t linked = 0;
+    for (std::size_t i = 0; i < slots.size(); ++i)
+      for (int f = 0; f < 4; ++f) {
+        const auto key = sorted_face(r.created[i], f);
+        TetId& neighbour = mesh_.neighbours[slots[i]][f];
+        FaceTag& tag = mesh_.face_tags[slots[i]][f];
+        const auto outer = std::find_if(boundary.begin(), boundary.end(), [&](const BoundaryFace& b) { return b.key == key; });
+        if (outer != boundary.end()) {
+          neighbour = outer->neighbour;
+          tag = outer->tag;
+          if (neighbour != no_tet) mesh_.neighbours[neighbour][outer->neighbour_face] = slots[i];
+          ++linked;
+          continue;
+        }
+        neighbour = no_tet;
+        for (std::size_t k = 0; k < slots.size() && neighbour == no_tet; ++k)
+          for (int g = 0; g < 4; ++g)
+            if (k != i && sorted_face(r.created[k], g) == key) neighbour = slots[k];
+        if (neighbour == no_tet) throw MeshingError("a flip left a face of tet " + std::to_string(slots[i]) + " without a neighbour");
+        const auto tagged = std::find_if(r.tagged_faces.begin(), r.tagged_faces.end(), [&](const auto& face) { return face.first == key; });
+        tag = tagged == r.tagged_faces.end() ? no_face_tag : tagged->second;
+      }
+    if (linked != boundary.size()) throw MeshingError("a flip changed the boundary of the tets it replaced");
+    if (r.surface_flip) flip_surface_triangles(*r.surface_flip);
+
+    const auto m = r.removed.size();
+    if (r.surface_flip) ++stats_.surface_edge_flips;
+    else if (m == 2) ++stats_.flips_2_3;
+    else if (m == 3 && r.created.size() == 2) ++stats_.flips_3_2;
+    else if (m == 4) ++stats_.flips_4_4;
+    else ++stats_.edge_removals;
+    stats_.tets_removed += static_cast<std::int64_t>(m);
+    stats_.tets_created += static_cast<std::int64_t>(r.created.size());
+  }
+
+  void flip_surface_triangles(const SurfaceFlip& flip) {
+    std::vector<std::array<int, 3>>& triangles = surfaces_[flip.surface]->triangles;
+    if (triangle_of_.empty()) triangle_of_.resize(surfaces_.size());
+    auto& index = triangle_of_[flip.surface];
+    if (index.empty())
+      for (int t = 0; t < static_cast<int>(triangles.size()); ++t) index.emplace(sorted_triangle(triangles[t]), t);
+    for (int k = 0; k < 2; ++k) {
+      const auto old = index.find(flip.removed[k]);
+      if (old == index.end()) throw MeshingError("an edge flip inside S_M did not find S_M's triangle");
+      const int t = old->second;
+      index.erase(old);
+      triangles[t] = flip.created[k];
+      index.emplace(sorted_triangle(flip.created[k]), t);
+    }
+  }
+
+  // Removes the free slots, keeping the live tets' order.
+  void compact() {
+    if (free_.empty()) return;
+    std::vector<TetId> renumbered(mesh_.tets.size(), no_tet);
+    TetId live = 0;
+    for (TetId t = 0; t < mesh_.num_tets(); ++t)
+      if (!dead(t)) renumbered[t] = live++;
+    for (TetId t = 0; t < mesh_.num_tets(); ++t) {
+      const TetId to = renumbered[t];
+      if (to == no_tet) continue;
+      mesh_.tets[to] = mesh_.tets[t];
+      mesh_.kinds[to] = mesh_.kinds[t];
+      mesh_.face_tags[to] = mesh_.face_tags[t];
+      for (TetRegion* region : regions_) (*region)[to] = (*region)[t];
+      for (int f = 0; f < 4; ++f) {
+        const TetId n = mesh_.neighbours[t][f];
+        mesh_.neighbours[to][f] = n == no_tet ? no_tet : renumbered[n];
+      }
+    }
+    mesh_.tets.resize(live);
+    mesh_.kinds.resize(live);
+    mesh_.face_tags.resize(live);
+    mesh_.neighbours.resize(live);
+    for (TetRegion* region : regions_) region->resize(live);
+    free_.clear();
+  }
+
+  TetMesh& mesh_;
+  std::span<SurfaceProjection* const> surfaces_;
+  std::span<TetRegion* const> regions_;  // per-tet flags that follow the flips
+  const ImprovementOptions& options_;
+  std::vector<int> surface_of_;  // the surface whose S_M holds each vertex, or -1
+  std::vector<int> node_index_;  // each S_M vertex's index in its surface's nodes, or -1
+  // Per surface, S_M's triangles by their sorted node indices: built at the first flip inside S_M.
+  std::vector<std::map<std::array<int, 3>, int>> triangle_of_;
+  std::vector<TetId> free_;      // slots of removed tets not yet reused
+  FlipStats stats_;
+};
+
+}  // namespace
+
+FlipStats& FlipStats::operator+=(const FlipStats& other) {
+  flips_2_3 += other.flips_2_3;
+  flips_3_2 += other.flips_3_2;
+  flips_4_4 += other.flips_4_4;
+  edge_removals += other.edge_removals;
+  surface_edge_flips += other.surface_edge_flips;
+  tets_removed += other.tets_removed;
+  tets_created += other.tets_created;
+  return *this;
+}
+
+FlipStats flip_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
+                          std::span<TetRegion* const> regions, const ImprovementOptions& options) {
+  return Flipper(mesh, surfaces, regions, options).run();
+}
+
+}  // namespace meccano

@@ -22,7 +22,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iostream>
 #include <map>
 #include <set>
 
@@ -209,7 +208,6 @@ TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
     const InsertionResult flipped = insert_surfaces(make_cube_meccano(c.box, 0), c.surfaces, options);
     ASSERT_TRUE(flipped.improvement.has_value());
     surface_edge_flips += flipped.improvement->flips.surface_edge_flips;
-    std::cerr << c.name << " ops " << flipped.improvement->flips.operations() << " sflips " << flipped.improvement->flips.surface_edge_flips << "\n";
     const MeshCheckReport check = verify_mesh(flipped.mesh, {.physical = true});
     ASSERT_TRUE(check.ok()) << check.summary();
     EXPECT_GE(flipped.quality_after_smoothing.equilateral.min, smoothed.improvement->min_quality_before);
@@ -250,6 +248,25 @@ TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
     }
   }
   EXPECT_GT(surface_edge_flips, 0) << "no case flipped an edge inside S_M: that path went untested";
+}
+
+// Hundreds of flips (the spherical cap with an irregular S_M at threshold 0.5), the same mesh on 1 and 2
+// threads.
+TEST(Flips, GiveTheSameMeshWithOneAndTwoThreads) {
+  const auto cases = testing::surface_cases(16, true);
+  const auto c = std::find_if(cases.begin(), cases.end(), [](const auto& c) { return c.name == "spherical_cap_perturbed_lr24"; });
+  ASSERT_NE(c, cases.end());
+  InsertionOptions options;
+  options.resolution = c->resolution;
+  options.improve = Improvement::topology;
+  options.improvement.threshold = 0.5;
+  options.threads = 1;
+  const InsertionResult one = insert_surfaces(make_cube_meccano(c->box, 0), c->surfaces, options);
+  options.threads = 2;
+  const InsertionResult two = insert_surfaces(make_cube_meccano(c->box, 0), c->surfaces, options);
+  ASSERT_GT(one.improvement->flips.operations(), 100);
+  EXPECT_EQ(one.mesh.tets, two.mesh.tets);
+  EXPECT_EQ(one.mesh.points, two.mesh.points);
 }
 
 }  // namespace

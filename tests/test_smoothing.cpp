@@ -215,6 +215,7 @@ TEST(Smoothing, GivesTheSameMeshWithOneAndTwoThreads) {
   omp_set_num_threads(threads);
   ASSERT_EQ(one.mesh.points.size(), two.mesh.points.size());
   for (std::size_t v = 0; v < one.mesh.points.size(); ++v) ASSERT_EQ(one.mesh.points[v], two.mesh.points[v]) << "node " << v;
+  EXPECT_EQ(one.mesh.tets, two.mesh.tets);
   EXPECT_EQ(one.smoothing.sweeps.size(), two.smoothing.sweeps.size());
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -75,10 +76,21 @@ class Flipper {
   }
 
   FlipStats run() {
-    for (int pass = 0; pass < options_.max_flip_passes; ++pass) {
-      const std::int64_t before = stats_.operations();
-      for (const auto& [quality, t] : worst_tets()) improve(t);
-      if (stats_.operations() == before) break;
+    std::vector<TetId> candidates(mesh_.tets.size());
+    std::iota(candidates.begin(), candidates.end(), TetId{0});
+    for (int pass = 1; pass <= options_.max_flip_passes; ++pass) {
+      const FlipStats before = stats_;
+      const auto worst = worst_of(candidates);
+      created_.clear();
+      for (const auto& [quality, t] : worst) improve(t);
+      if (options_.progress)
+        options_.progress("improvement flips " + std::to_string(pass) + ": " + std::to_string(worst.size()) +
+                          " tets below the threshold tried; " + describe(stats_ - before));
+      if (stats_.operations() == before.operations()) break;
+      // Flips move no node: the tets below the threshold now are among those tried and those created.
+      candidates.clear();
+      for (const auto& [quality, t] : worst) candidates.push_back(t);
+      candidates.insert(candidates.end(), created_.begin(), created_.end());
     }
     compact();
     return stats_;
@@ -105,10 +117,13 @@ class Flipper {
     return quality(tet);
   }
 
-  // The live tets below the threshold, worst first (ties by index: a fixed order).
-  std::vector<std::pair<double, TetId>> worst_tets() const {
+  // The live tets among `tets` (repeats allowed) below the threshold, worst first (ties by index: a fixed
+  // order).
+  std::vector<std::pair<double, TetId>> worst_of(std::vector<TetId>& tets) const {
+    std::sort(tets.begin(), tets.end());
+    tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
     std::vector<std::pair<double, TetId>> worst;
-    for (TetId t = 0; t < mesh_.num_tets(); ++t) {
+    for (TetId t : tets) {
       if (dead(t)) continue;
       const double q = quality(mesh_.oriented_tet(t));
       if (q < cubed_threshold()) worst.emplace_back(q, t);
@@ -388,6 +403,7 @@ class Flipper {
       for (TetId parent : parents) flags[k].push_back((*regions_[k])[parent]);
 
     const std::vector<TetId> slots = take_slots(r.removed, r.created.size());
+    created_.insert(created_.end(), slots.begin(), slots.end());
     for (std::size_t i = 0; i < slots.size(); ++i) {
       mesh_.tets[slots[i]] = r.created[i];
       mesh_.kinds[slots[i]] = TetKind::remeshed();
@@ -480,6 +496,7 @@ class Flipper {
   // Per surface, S_M's triangles by their sorted node indices: built at the first flip inside S_M.
   std::vector<std::map<std::array<int, 3>, int>> triangle_of_;
   std::vector<TetId> free_;      // slots of removed tets not yet reused
+  std::vector<TetId> created_;   // the slots filled by this pass's flips
   FlipStats stats_;
 };
 
@@ -494,6 +511,23 @@ FlipStats& FlipStats::operator+=(const FlipStats& other) {
   tets_removed += other.tets_removed;
   tets_created += other.tets_created;
   return *this;
+}
+
+FlipStats operator-(FlipStats a, const FlipStats& b) {
+  a.flips_2_3 -= b.flips_2_3;
+  a.flips_3_2 -= b.flips_3_2;
+  a.flips_4_4 -= b.flips_4_4;
+  a.edge_removals -= b.edge_removals;
+  a.surface_edge_flips -= b.surface_edge_flips;
+  a.tets_removed -= b.tets_removed;
+  a.tets_created -= b.tets_created;
+  return a;
+}
+
+std::string describe(const FlipStats& flips) {
+  return std::to_string(flips.flips_2_3) + " 2-3, " + std::to_string(flips.flips_3_2) + " 3-2, " +
+         std::to_string(flips.flips_4_4) + " 4-4 flips, " + std::to_string(flips.edge_removals) +
+         " larger edge removals, " + std::to_string(flips.surface_edge_flips) + " edge flips inside S_M";
 }
 
 FlipStats flip_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,

@@ -186,20 +186,16 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
     const auto started = std::chrono::steady_clock::now();
     ImprovementOptions improvement = options.improvement;
     improvement.topology = options.improve == Improvement::topology;
+    if (options.progress) improvement.progress = options.progress;
     std::vector<TetRegion*> regions;
     for (SurfaceInsertion& inserted : result.surfaces) regions.push_back(&inserted.volumetric);
     const ImprovementStats& improved = result.improvement.emplace(
         improve_worst_tets(result.mesh, projections, improvement, options.smoothing, regions));
     result.improvement_seconds = seconds_since(started);
-    const FlipStats& flips = improved.flips;
     report(options, "improvement: ", improved.passes, " passes over the tets below ", improvement.threshold,
            " (", improved.tets_below_before, " before, ", improved.tets_below_after, " after), ", improved.nodes_moved,
            " of ", improved.node_updates, " node updates moved",
-           improvement.topology ? "; " + std::to_string(improved.rounds) + " rounds of flips: " +
-                                      std::to_string(flips.flips_2_3) + " 2-3, " + std::to_string(flips.flips_3_2) +
-                                      " 3-2, " + std::to_string(flips.flips_4_4) + " 4-4, " +
-                                      std::to_string(flips.edge_removals) + " larger edge removals, " +
-                                      std::to_string(flips.surface_edge_flips) + " edge flips inside S_M"
+           improvement.topology ? "; " + std::to_string(improved.rounds) + " rounds of flips: " + describe(improved.flips)
                                 : std::string(),
            "; smallest quality ", improved.min_quality_before, " -> ", improved.min_quality_after, " (equilateral)");
     check_stage(result.mesh, "improvement");

@@ -180,7 +180,8 @@ class Smoother {
   }
 
   SmoothingStats run();
-  ImprovementStats improve(const ImprovementOptions& options);
+  // `only`, if not empty, limits the nodes optimised to those it flags (per vertex).
+  ImprovementStats improve(const ImprovementOptions& options, std::span<const std::uint8_t> only = {});
 
  private:
   static Matrix3d equilateral_target() {
@@ -759,7 +760,7 @@ SmoothingStats Smoother::run() {
   return stats_;
 }
 
-ImprovementStats Smoother::improve(const ImprovementOptions& options) {
+ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<const std::uint8_t> only) {
   improving_ = &options;
   tangled_ = false;
   aim_at(SmoothingTarget::meccano);
@@ -769,7 +770,7 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options) {
   ImprovementStats stats;
   std::vector<double> quality(mesh_.tets.size());
   std::vector<std::uint8_t> movable(mesh_.points.size(), 0);
-  for (VertexId v : free_nodes()) movable[v] = 1;
+  for (VertexId v : free_nodes()) movable[v] = only.empty() || only[v];
   // The equilateral mean ratio of the given tets (those whose nodes may have moved).
   auto measure_tets = [&](const std::vector<TetId>& tets) {
     const auto count = static_cast<std::int64_t>(tets.size());
@@ -804,7 +805,8 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options) {
 #pragma omp parallel for schedule(dynamic, 16) reduction(+ : moved)
       for (std::int64_t i = 0; i < size; ++i) moved += optimise(group[i]);
     }
-    stats.node_updates += static_cast<std::int64_t>(nodes.size());
+    const std::size_t tried = nodes.size();
+    stats.node_updates += static_cast<std::int64_t>(tried);
     stats.nodes_moved += moved;
     std::vector<TetId> touched;
     for (VertexId v : nodes) touched.insert(touched.end(), stars_.of(v).begin(), stars_.of(v).end());
@@ -812,6 +814,11 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options) {
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
     measure_tets(touched);
     nodes = worst_nodes();
+    if (options.progress)
+      options.progress("improvement pass " + std::to_string(stats.passes) + ": " + std::to_string(moved) + " of " +
+                       std::to_string(tried) + " nodes moved; " + std::to_string(below_threshold()) +
+                       " tets below the threshold, smallest quality " +
+                       std::to_string(*std::min_element(quality.begin(), quality.end())));
     if (moved == 0) break;
   }
   stats.tets_below_after = below_threshold();
@@ -838,18 +845,24 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
                                     std::span<TetRegion* const> regions) {
   // improve() sets both targets; SUS's mode and band decide which nodes are free. A flip changes the
   // stars, so each round smooths with a Smoother built afresh.
-  auto smooth = [&] {
+  auto smooth = [&](std::span<const std::uint8_t> only) {
     return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})
-        .improve(options);
+        .improve(options, only);
   };
-  ImprovementStats stats = smooth();
+  ImprovementStats stats = smooth({});
   if (!options.topology) return stats;
   for (int round = 0; round < options.rounds; ++round) {
     const FlipStats flips = flip_worst_tets(mesh, surfaces, regions, options);
     if (flips.operations() == 0) break;
     ++stats.rounds;
     stats.flips += flips;
-    const ImprovementStats smoothed = smooth();
+    // Elsewhere the nodes and their stars are as the last smoothing left them, which would do the same
+    // again: only the nodes of flipped tets are optimised.
+    std::vector<std::uint8_t> flipped(mesh.points.size(), 0);
+    for (TetId t = 0; t < mesh.num_tets(); ++t)
+      if (!mesh.bisectable(t))
+        for (VertexId v : mesh.tets[t]) flipped[v] = 1;
+    const ImprovementStats smoothed = smooth(flipped);
     stats.passes += smoothed.passes;
     stats.node_updates += smoothed.node_updates;
     stats.nodes_moved += smoothed.nodes_moved;

@@ -43,7 +43,9 @@
 #include <meccano/volumetric_approximation.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <span>
+#include <string>
 
 namespace meccano {
 
@@ -56,6 +58,7 @@ struct ImprovementOptions {
   int rounds = 3;           // topology: at most this many rounds of flips, each followed by smoothing
   int max_flip_passes = 4;  // flip passes per round
   int max_ring = 10;        // the most tets around an edge that edge removal considers
+  std::function<void(const std::string&)> progress;  // a line per smoothing pass and per flip pass, if set
 };
 
 struct FlipStats {
@@ -66,6 +69,9 @@ struct FlipStats {
   std::int64_t operations() const { return flips_2_3 + flips_3_2 + flips_4_4 + edge_removals + surface_edge_flips; }
   FlipStats& operator+=(const FlipStats& other);
 };
+FlipStats operator-(FlipStats a, const FlipStats& b);
+std::string describe(const FlipStats& flips);  // "N 2-3, N 3-2, N 4-4 flips, N larger edge removals, ..."
+
 
 struct ImprovementStats {
   int passes = 0;                                            // smoothing passes, over all rounds

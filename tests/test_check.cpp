@@ -268,6 +268,24 @@ TEST_F(Check, InterfaceDefectsAreNamed) {
   const MeshFileCheck with_flip = check_msh_mesh(flipped);
   EXPECT_TRUE(mentions(with_flip.find("interface_patch"), "inconsistent orientation")) << with_flip.text();
 
+  // A tet with all four nodes on the interface: a tet with an interface face, its fourth node swapped for
+  // another interface node.
+  MshMesh lying = original;
+  {
+    const std::array<int, 3> face = lying.triangles[group(lying, "interface_patch").elements[0]];
+    const std::array<int, 3> other = lying.triangles[group(lying, "interface_patch").elements[1]];
+    const int off = *std::ranges::find_if(other, [&](int v) { return std::ranges::find(face, v) == face.end(); });
+    const auto tet = std::ranges::find_if(lying.tets, [&](const std::array<int, 4>& t) {
+      return std::ranges::all_of(face, [&](int v) { return std::ranges::find(t, v) != t.end(); });
+    });
+    ASSERT_NE(tet, lying.tets.end());
+    for (int& v : *tet)
+      if (std::ranges::find(face, v) == face.end()) v = off;
+  }
+  EXPECT_TRUE(mentions(check_msh_mesh(lying).find("interface_patch"), "1 tets have all four nodes on the interface"))
+      << check_msh_mesh(lying).text();
+  EXPECT_TRUE(check_msh_mesh(original).find("interface_patch")->passed);
+
   // A box-side triangle in the interface: not an interior face.
   MshMesh outside = original;
   group(outside, "interface_patch").elements.push_back(group(outside, "xmin").elements[0]);

@@ -254,7 +254,7 @@ TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
 // threads.
 TEST(Flips, GiveTheSameMeshWithOneAndTwoThreads) {
   const auto cases = testing::surface_cases(16, true);
-  const auto c = std::find_if(cases.begin(), cases.end(), [](const auto& c) { return c.name == "spherical_cap_perturbed_lr24"; });
+  const auto c = std::find_if(cases.begin(), cases.end(), [](const auto& candidate) { return candidate.name == "spherical_cap_perturbed_lr24"; });
   ASSERT_NE(c, cases.end());
   InsertionOptions options;
   options.resolution = c->resolution;

@@ -263,12 +263,13 @@ class MeshFileChecker {
     if (topology.euler() != 1) problem(check, "Euler characteristic ", topology.euler(), " (a disk has 1)");
     if (boundary_loops != 1) problem(check, boundary_loops, " boundary loops (a disk has one)");
     if (flipped > 0) problem(check, flipped, " edges run twice in the same direction (inconsistent orientation)");
-    // A fault solver needs a node off the interface in every tet (its unknowns split across it).
+    // Not a defect of the mesh, but a fault solver that splits the interface's nodes needs a node off the
+    // interface in every tet: counted, not failed (a coarse mesh that keeps the surface may have some).
     const auto on_interface = [&](int node) { return std::ranges::binary_search(vertices, node); };
     const auto lying_on = std::ranges::count_if(mesh_.tets, [&](const std::array<int, 4>& tet) { return std::ranges::all_of(tet, on_interface); });
-    if (lying_on > 0) problem(check, lying_on, " tets have all four nodes on the interface");
     check.summary = std::to_string(triangles.size()) + " triangles, Euler characteristic " +
                     std::to_string(topology.euler()) + ", " + std::to_string(boundary_loops) + " boundary loop(s)";
+    if (lying_on > 0) check.summary += ", " + std::to_string(lying_on) + " tets with all four nodes on it";
     return check;
   }
 

@@ -12,8 +12,9 @@
 //                      side's area, and the unshared faces of the tets are exactly the box sides' faces;
 //         interface_NAME, one per such group: interior faces only (each shared by two tets), a connected
 //                      manifold disk (Euler characteristic 1, one boundary loop, no pinched vertex),
-//                      consistently oriented, and no tet with all four nodes on it (a fault solver needs
-//                      a node off the interface in every tet).
+//                      consistently oriented. The summary counts the tets with all four nodes on it,
+//                      if any: not a failure, but a fault solver that splits the interface's nodes needs
+//                      none (the module's meshes have none; TetGen's with -Y, coarse, may).
 //         Planes and areas are compared to 1e-9 of the box's largest extent (squared for areas).
 // Output  one CheckResult per check, each with its counts and the first problems, naming the file's
 //         element tags; text() for a terminal, json() for a report.

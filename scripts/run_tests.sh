@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Set up the machine, build, and run the whole test suite with CTest; then the quick sanitized subset
-# (ASan + UBSan, scripts/run_sanitized_tests.sh --quick) and a short fuzzing run of the surface readers
-# and the validation (20 s per target) when clang and libFuzzer are available.
+# Set up the machine, build with warnings as errors (MECCANO_WERROR), and run the whole test suite with
+# CTest (every label: unit, pipeline, long); then the quick sanitized subset (ASan + UBSan,
+# scripts/run_sanitized_tests.sh --quick) and a short fuzzing run of the surface readers and the
+# validation (20 s per target) when clang and libFuzzer are available.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-scripts/build.sh
+MECCANO_WERROR=ON scripts/build.sh
 ctest --test-dir build -j"$(nproc)" --output-on-failure
 scripts/run_sanitized_tests.sh --quick build-asan
 if command -v clang++ > /dev/null && echo 'extern "C" int LLVMFuzzerTestOneInput(const char*, unsigned long) { return 0; }' \

@@ -13,7 +13,8 @@ add_test(NAME consumer_pkg_config
 
 set_tests_properties(consumer_install consumer_find_package consumer_pkg_config PROPERTIES
   ENVIRONMENT "CMAKE=${CMAKE_COMMAND};CXX=${CMAKE_CXX_COMPILER}"
-  TIMEOUT 600)
+  TIMEOUT 600
+  LABELS pipeline)
 set_tests_properties(consumer_install PROPERTIES FIXTURES_SETUP meccano_installed)
 set_tests_properties(consumer_find_package consumer_pkg_config PROPERTIES FIXTURES_REQUIRED meccano_installed)
 
@@ -24,5 +25,6 @@ if(TARGET meccano_dealii)
   set_tests_properties(consumer_dealii PROPERTIES
     ENVIRONMENT "CMAKE=${CMAKE_COMMAND};CXX=${CMAKE_CXX_COMPILER}"
     TIMEOUT 900
-    FIXTURES_REQUIRED meccano_installed)
+    FIXTURES_REQUIRED meccano_installed
+    LABELS long)
 endif()

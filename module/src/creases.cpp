@@ -1,5 +1,7 @@
 #include <meccano/creases.hpp>
 
+#include <meccano/geometry.hpp>
+
 #include "topology_helpers.hpp"
 
 #include <Eigen/Geometry>
@@ -18,7 +20,6 @@ using detail::make_edge;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
-double cross2(const Vector2d& a, const Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // The crease edges of S (with their angles) and the vertices on its rim.
 struct CreaseGraph {

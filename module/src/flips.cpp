@@ -32,7 +32,6 @@ bool same_orientation(Tet from, const Tet& to) {
   return even;
 }
 
-// Some tets and the positively oriented tets that would replace them, filling the same cavity.
 // A face of the boundary of the tets a flip replaces.
 struct BoundaryFace {
   std::array<VertexId, 3> key;  // sorted vertices
@@ -49,6 +48,7 @@ struct SurfaceFlip {
   std::array<std::array<int, 3>, 2> created;  // oriented like S
 };
 
+// Some tets and the positively oriented tets that would replace them, filling the same cavity.
 struct Retriangulation {
   std::vector<TetId> removed;
   std::vector<Tet> created;
@@ -97,15 +97,11 @@ class Flipper {
   }
 
  private:
-  // The cube of the equilateral mean ratio of a positively ordered tet, 15552 V² / (Σ l²)³, negative when
-  // inverted: the same order as the mean ratio, without its cube root (flips only compare qualities).
+  // The cube of the equilateral mean ratio of a positively ordered tet, negative when inverted: flips only
+  // compare qualities, and the cube orders them the same way without a cube root.
   double quality(const Tet& tet) const {
-    const TetPoints p{mesh_.points[tet[0]], mesh_.points[tet[1]], mesh_.points[tet[2]], mesh_.points[tet[3]]};
-    double sum_squared_edges = 0.0;
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) sum_squared_edges += (p[i] - p[j]).squaredNorm();
-    const double volume = signed_volume(p[0], p[1], p[2], p[3]);
-    const double cubed = 15552.0 * volume * std::abs(volume) / (sum_squared_edges * sum_squared_edges * sum_squared_edges);
+    const double cubed = mean_ratio_equilateral_cubed(
+        {mesh_.points[tet[0]], mesh_.points[tet[1]], mesh_.points[tet[2]], mesh_.points[tet[3]]});
     return std::isfinite(cubed) ? cubed : unacceptable;
   }
   // A new tet's quality, unacceptable when its four vertices lie on one surface (a fault solver cannot
@@ -298,10 +294,7 @@ class Flipper {
     const SurfaceProjection& projection = *surfaces_[surface];
     const int na = node_index_[a], nb = node_index_[b], np = node_index_[p], nq = node_index_[q];
     auto uv = [&](int node) { return projection.uv[node]; };
-    auto orient = [&](int x, int y, int z) {
-      const Eigen::Vector2d e = uv(y) - uv(x), f = uv(z) - uv(x);
-      return e.x() * f.y() - e.y() * f.x();
-    };
+    auto orient = [&](int x, int y, int z) { return cross2(uv(y) - uv(x), uv(z) - uv(x)); };
     if (!(orient(np, nq, na) * orient(np, nq, nb) < 0.0) || !(orient(na, nb, np) * orient(na, nb, nq) < 0.0))
       return std::nullopt;
     auto deviation = [&](int x, int y, int z) {
@@ -339,12 +332,13 @@ class Flipper {
     Retriangulation r;
     r.removed = {t, n};
     r.worst_removed = std::min(quality(mesh_.oriented_tet(t)), quality(mesh_.oriented_tet(n)));
+    r.worst_created = std::numeric_limits<double>::infinity();
     const Tet oriented = mesh_.oriented_tet(t);
     for (VertexId replaced : tv) {
       if (replaced == tv[f]) continue;
       Tet created = oriented;
       created[local_index(oriented, replaced)] = apex;
-      r.worst_created = r.created.empty() ? new_tet_quality(created) : std::min(r.worst_created, new_tet_quality(created));
+      r.worst_created = std::min(r.worst_created, new_tet_quality(created));
       r.created.push_back(created);
       r.flag_parent.push_back(t);
     }
@@ -502,25 +496,18 @@ class Flipper {
 
 }  // namespace
 
+// Every count of FlipStats, for the arithmetic below.
+constexpr std::array flip_counts{&FlipStats::flips_2_3,     &FlipStats::flips_3_2,          &FlipStats::flips_4_4,
+                                 &FlipStats::edge_removals, &FlipStats::surface_edge_flips, &FlipStats::tets_removed,
+                                 &FlipStats::tets_created};
+
 FlipStats& FlipStats::operator+=(const FlipStats& other) {
-  flips_2_3 += other.flips_2_3;
-  flips_3_2 += other.flips_3_2;
-  flips_4_4 += other.flips_4_4;
-  edge_removals += other.edge_removals;
-  surface_edge_flips += other.surface_edge_flips;
-  tets_removed += other.tets_removed;
-  tets_created += other.tets_created;
+  for (auto count : flip_counts) this->*count += other.*count;
   return *this;
 }
 
 FlipStats operator-(FlipStats a, const FlipStats& b) {
-  a.flips_2_3 -= b.flips_2_3;
-  a.flips_3_2 -= b.flips_3_2;
-  a.flips_4_4 -= b.flips_4_4;
-  a.edge_removals -= b.edge_removals;
-  a.surface_edge_flips -= b.surface_edge_flips;
-  a.tets_removed -= b.tets_removed;
-  a.tets_created -= b.tets_created;
+  for (auto count : flip_counts) a.*count -= b.*count;
   return a;
 }
 

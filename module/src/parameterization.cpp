@@ -1,6 +1,7 @@
 #include <meccano/parameterization.hpp>
 
 #include <meccano/error.hpp>
+#include <meccano/geometry.hpp>
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
@@ -36,7 +37,6 @@ constexpr double natural_corner_turn = std::numbers::pi / 4;
 const char* const side_names[4] = {"side 0 (v = 0)", "side 1 (u = 1)", "side 2 (v = 1)", "side 3 (u = 0)"};
 const Vector2d square_corners[4] = {{0.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}, {0.0, 1.0}};
 
-double cross2(const Vector2d& a, const Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // The disk with its vertices renumbered compactly (in increasing view order), its triangle adjacency and
 // its rim. Corner c = 3 t + k is corner k of triangle t.

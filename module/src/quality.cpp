@@ -145,15 +145,29 @@ double signed_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const E
   return (b - a).dot((c - a).cross(d - a)) / 6.0;
 }
 
+namespace {
+double sum_of_squared_edges(const TetPoints& p) {
+  double sum = 0.0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) sum += (p[i] - p[j]).squaredNorm();
+  return sum;
+}
+}  // namespace
+
 double mean_ratio_equilateral(const TetPoints& p) {
   // The closed form of 3|σ|^(2/3)/||S||^2 for S = A W^-1, W the unit equilateral tet.
-  double sum_squared_edges = 0.0;
-  for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j) sum_squared_edges += (p[i] - p[j]).squaredNorm();
+  const double sum_squared_edges = sum_of_squared_edges(p);
   const double volume = signed_volume(p[0], p[1], p[2], p[3]);
   if (sum_squared_edges <= 0.0) return 0.0;
   const double magnitude = 12.0 * std::cbrt(9.0 * volume * volume) / sum_squared_edges;
   return volume < 0.0 ? -magnitude : magnitude;
+}
+
+double mean_ratio_equilateral_cubed(const TetPoints& p) {
+  const double sum_squared_edges = sum_of_squared_edges(p);
+  const double volume = signed_volume(p[0], p[1], p[2], p[3]);
+  if (sum_squared_edges <= 0.0) return 0.0;
+  return 15552.0 * volume * std::abs(volume) / (sum_squared_edges * sum_squared_edges * sum_squared_edges);
 }
 
 double mean_ratio_relative(const TetPoints& physical, const TetPoints& computational) {

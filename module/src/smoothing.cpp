@@ -549,8 +549,7 @@ bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& u
     std::array<Vector2d, 3> corner;
     const auto& triangle = projection.triangles[node_triangles_[node.surface][k]];
     for (int c = 0; c < 3; ++c) corner[c] = triangle[c] == node.index ? uv : projection.uv[triangle[c]];
-    const Vector2d a = corner[1] - corner[0], b = corner[2] - corner[0];
-    if ((a.x() * b.y() - a.y() * b.x()) * projection.orientation <= 0.0) return false;
+    if (cross2(corner[1] - corner[0], corner[2] - corner[0]) * projection.orientation <= 0.0) return false;
   }
   return true;
 }

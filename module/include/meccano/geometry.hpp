@@ -30,6 +30,10 @@ using Tetrahedron3 = std::array<Eigen::Vector3d, 4>;
 
 Eigen::AlignedBox3d bounding_box(std::span<const Eigen::Vector3d> points);
 
+// The 2D cross product a.x b.y - a.y b.x: twice the signed area of the triangle (0, a, b), positive when
+// it turns counterclockwise.
+inline double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
 double tetrahedron_longest_edge(const Tetrahedron3& tet);
 
 // Whether the triangle meets the closed tetrahedron: a separating axis test (axis-aligned directions,

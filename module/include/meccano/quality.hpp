@@ -30,6 +30,9 @@ using TetPoints = std::array<Eigen::Vector3d, 4>;
 double signed_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                      const Eigen::Vector3d& d);
 double mean_ratio_equilateral(const TetPoints& p);
+// Its cube, 15552 V^2 / (Σ l_i^2)^3 with the sign of V: the same order without a cube root, for code
+// that only compares qualities.
+double mean_ratio_equilateral_cubed(const TetPoints& p);
 double mean_ratio_relative(const TetPoints& physical, const TetPoints& computational);
 std::array<double, 6> dihedral_angles_deg(const TetPoints& p);
 

@@ -267,6 +267,9 @@ TEST(Smoothing, FallsBackToTheEquilateralTargetWhereTheMeccanoTargetStalls) {
   InsertionOptions options;
   options.resolution = 0.025860230418841217;
   options.approximation.side_rule = SideRule::positive_only;
+  // Smoothing alone after SUS: every tet keeps its meccano counterpart, which the bound below is about (a
+  // crease mend's tets are measured against the equilateral tet).
+  options.improve = Improvement::smooth;
   const InsertionResult result = insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {&surface, 1}, options);
   EXPECT_TRUE(result.smoothing.untangled());
   EXPECT_EQ(result.smoothing.fallback_sweep, options.smoothing.fallback_sweeps + 1);

@@ -56,11 +56,7 @@ CreaseGraph crease_graph(const TriangleSurface& surface, double angle) {
 }
 
 // A point of P where a line crosses an S_M edge, at arc length s along the line.
-struct Crossing {
-  double s;
-  int a, b;  // the edge's nodes
-  Vector2d at;
-};
+using Crossing = CreaseCrossing;
 
 // S_M's edges in a uniform grid over P, for the crossings of a segment.
 class EdgeGrid {
@@ -79,7 +75,7 @@ class EdgeGrid {
   }
 
   // The crossings of segment p -> q (arc length s0 at p) with S_M edges, appended to `out`.
-  void crossings(const Vector2d& p, const Vector2d& q, double s0, int segment, std::vector<Crossing>& out) {
+  void crossings(int line, const Vector2d& p, const Vector2d& q, double s0, int segment, std::vector<Crossing>& out) {
     const auto [lo, hi] = cell_range(p, q);
     const Vector2d d = q - p;
     for (int j = lo[1]; j <= hi[1]; ++j)
@@ -96,7 +92,7 @@ class EdgeGrid {
           const double t = cross2(u - p, w - u) / denominator;
           const double r = cross2(u - p, d) / denominator;
           if (t < 0.0 || t > 1.0 || r < 0.0 || r > 1.0) continue;
-          out.push_back({s0 + t * d.norm(), a, b, p + t * d});
+          out.push_back({line, s0 + t * d.norm(), a, b, r, p + t * d});
         }
   }
 
@@ -324,7 +320,7 @@ CreaseNodes follow_creases(std::vector<CreaseLine> lines, std::span<const std::a
   for (std::size_t l = 0, segment = 0; l < result.lines.size(); ++l) {
     const CreaseLine& line = result.lines[l];
     for (std::size_t i = 0; i + 1 < line.uv.size(); ++i, ++segment)
-      grid.crossings(line.uv[i], line.uv[i + 1], line.arc[i], static_cast<int>(segment), crossings[l]);
+      grid.crossings(static_cast<int>(l), line.uv[i], line.uv[i + 1], line.arc[i], static_cast<int>(segment), crossings[l]);
     stats.crossings += static_cast<std::int64_t>(crossings[l].size());
     stats.sharpest = std::max(stats.sharpest, line.angle);
   }
@@ -342,17 +338,26 @@ CreaseNodes follow_creases(std::vector<CreaseLine> lines, std::span<const std::a
     snap_path(static_cast<int>(l), path, triangles, uv, may_join, orientation, around, result);
   }
   // What is left: the line passing through an S_M edge rather than along S_M edges.
-  EdgeGrid after(triangles, uv);
-  for (std::size_t l = 0, segment = 0; l < result.lines.size(); ++l) {
-    const CreaseLine& line = result.lines[l];
-    std::vector<Crossing> left;
-    for (std::size_t i = 0; i + 1 < line.uv.size(); ++i, ++segment)
-      after.crossings(line.uv[i], line.uv[i + 1], line.arc[i], static_cast<int>(segment), left);
-    const auto on_line = [&](int v) { return result.line_of[v] == static_cast<int>(l); };
-    stats.straddling += std::ranges::count_if(
-        left, [&](const Crossing& crossing) { return !on_line(crossing.a) && !on_line(crossing.b); });
-  }
+  stats.straddling = static_cast<std::int64_t>(straddling_crossings(result, triangles, uv).size());
   return result;
+}
+
+std::vector<CreaseCrossing> straddling_crossings(const CreaseNodes& creases, std::span<const std::array<int, 3>> triangles,
+                                                 std::span<const Vector2d> uv) {
+  std::vector<CreaseCrossing> straddling;
+  if (creases.lines.empty()) return straddling;
+  EdgeGrid grid(triangles, uv);
+  for (std::size_t l = 0, segment = 0; l < creases.lines.size(); ++l) {
+    const CreaseLine& line = creases.lines[l];
+    std::vector<Crossing> crossings;
+    for (std::size_t i = 0; i + 1 < line.uv.size(); ++i, ++segment)
+      grid.crossings(static_cast<int>(l), line.uv[i], line.uv[i + 1], line.arc[i], static_cast<int>(segment), crossings);
+    std::ranges::sort(crossings, {}, &Crossing::s);
+    const auto on_line = [&](int v) { return creases.line_of[v] == static_cast<int>(l); };
+    for (const Crossing& crossing : crossings)
+      if (!on_line(crossing.a) && !on_line(crossing.b)) straddling.push_back(crossing);
+  }
+  return straddling;
 }
 
 }  // namespace meccano

@@ -19,6 +19,11 @@ namespace {
 
 using Tet = std::array<VertexId, 4>;
 constexpr double unacceptable = -std::numeric_limits<double>::infinity();
+// A crease mend may leave a tet this poor (equilateral mean ratio), or as poor as the mesh's worst if that
+// is poorer, for the smoothing after it to lift (doc/benchmarks.md, "Creases").
+constexpr double crease_floor = 0.1;
+// Passes of conform_to_creases per surface: each mends crossings that the previous ones made or left.
+constexpr int max_crease_passes = 8;
 
 // True when `to` is an even permutation of `from` (same vertices): the same orientation.
 bool same_orientation(Tet from, const Tet& to) {
@@ -58,6 +63,8 @@ struct Retriangulation {
   // An edge removal inside S_M: the faces of `created` that become interface faces, and S_M's change.
   std::vector<std::pair<std::array<VertexId, 3>, FaceTag>> tagged_faces;
   std::optional<SurfaceFlip> surface_flip;
+  // A crease split: the apexes x of the S_M triangles (a, b, x) it halves (empty for flips).
+  std::vector<VertexId> split_apexes;
 };
 
 class Flipper {
@@ -73,6 +80,37 @@ class Flipper {
       }
     for (const TetRegion* region : regions)
       if (region->size() != mesh.tets.size()) throw std::invalid_argument("flip_worst_tets: a region's size is not the tet count");
+  }
+
+  // Mends S_M where a crease line of S crosses one of its edges between the edge's nodes
+  // (straddling_crossings): the two S_M triangles there are chords across the crease, their normals off
+  // both sides' (by up to 60 degrees on real faults). Passes repeat while they mend any, since a mend
+  // changes which edges the lines cross; each crossing gets the best of its mends (mend_crossing).
+  FlipStats conform_to_creases() {
+    double worst = std::numeric_limits<double>::infinity();
+    for (TetId t = 0; t < mesh_.num_tets(); ++t) worst = std::min(worst, quality(mesh_.oriented_tet(t)));
+    mend_floor_ = std::max(std::pow(crease_floor, 3), worst);  // quality() is cubed
+    incident_.assign(mesh_.points.size(), no_tet);
+    for (TetId t = 0; t < mesh_.num_tets(); ++t)
+      for (VertexId v : mesh_.tets[t]) incident_[v] = t;
+    for (int s = 0; s < static_cast<int>(surfaces_.size()); ++s) {
+      triangle_index(s);
+      for (int pass = 0; pass < max_crease_passes; ++pass) {
+        const SurfaceProjection& projection = *surfaces_[s];
+        std::vector<int> touched;  // nodes of the edges mended in this pass: their other crossings wait
+        for (const CreaseCrossing& crossing : straddling_crossings(projection.creases, projection.triangles, projection.uv)) {
+          if (std::ranges::find(touched, crossing.a) != touched.end() ||
+              std::ranges::find(touched, crossing.b) != touched.end() || !mend_crossing(s, crossing))
+            continue;
+          touched.push_back(crossing.a);
+          touched.push_back(crossing.b);
+        }
+        if (touched.empty()) break;
+      }
+    }
+    incident_.clear();
+    compact();
+    return stats_;
   }
 
   FlipStats run() {
@@ -155,6 +193,227 @@ class Flipper {
     if (best) apply(*best);
   }
 
+  // The tets holding vertex v (found from incident_).
+  std::vector<TetId> star_of(VertexId v) const {
+    std::vector<TetId> star{incident_[v]};
+    for (std::size_t i = 0; i < star.size(); ++i)
+      for (int f = 0; f < 4; ++f) {
+        const TetId n = mesh_.neighbours[star[i]][f];
+        if (mesh_.tets[star[i]][f] != v && n != no_tet && std::ranges::find(star, n) == star.end()) star.push_back(n);
+      }
+    return star;
+  }
+
+  double worst_of_tets(std::span<const TetId> tets) const {
+    double worst = std::numeric_limits<double>::infinity();
+    for (TetId t : tets) worst = std::min(worst, quality(mesh_.oriented_tet(t)));
+    return worst;
+  }
+
+  // Mends one crossing of surface s's S_M edge (a, b) by a crease line. If S_M's triangles (a, b, p) and
+  // (b, a, q) have p and q on the line, by flipping (a, b) to (p, q), which lies along it. Otherwise by the
+  // best of: moving a onto the crossing, moving b there (a node neither on the rim nor on a line already),
+  // or splitting the edge there (the tets around it halved); the new or moved node lies at φ of the
+  // crossing, on the crease edges of S. A mend must align the S_M triangles it changes better with S
+  // (their worst alignment), keep S_M embedded in P, and leave no tet inverted or below both crease_floor
+  // and the worst tet it changes. Whether a mend was made.
+  bool mend_crossing(int s, const CreaseCrossing& crossing) {
+    SurfaceProjection& projection = *surfaces_[s];
+    const CreaseLine& line = projection.creases.lines[crossing.line];
+    // A crossing at a line's end touches the rim of S or another line's end, where the node could not move.
+    if (projection.on_rim[crossing.a] && projection.on_rim[crossing.b]) return false;
+    if (!(crossing.s > 1e-9 * line.length() && crossing.s < (1.0 - 1e-9) * line.length())) return false;
+    const VertexId a = projection.nodes[crossing.a], b = projection.nodes[crossing.b];
+    const std::vector<TetId> around_a = star_of(a);
+    const auto start = std::ranges::find_if(around_a, [&](TetId t) { return std::ranges::find(mesh_.tets[t], b) != mesh_.tets[t].end(); });
+    if (start == around_a.end()) throw MeshingError("an S_M edge of surface " + std::to_string(s) + " is not an edge of the mesh");
+
+    if (std::optional<Retriangulation> flip = edge_removal(*start, a, b, mend_floor_);
+        flip && flip->surface_flip) {
+      bool along = true;
+      for (const auto& triangle : flip->surface_flip->created)
+        for (int node : triangle)
+          if (node != crossing.a && node != crossing.b) along &= projection.creases.line_of[node] == crossing.line;
+      if (along && acceptable(flip->worst_created, flip->worst_removed) && apply(*flip)) return true;
+    }
+
+    const Eigen::Vector3d point = projection.surface->evaluate(projection.surface->locate(crossing.at));
+    int mover = -1;
+    double best = unacceptable;
+    for (int node : {crossing.a, crossing.b}) {
+      if (projection.on_rim[node] || projection.creases.line_of[node] >= 0) continue;
+      const VertexId v = projection.nodes[node];
+      const std::vector<TetId> star = star_of(v);
+      const std::vector<std::array<int, 3>> triangles = surface_triangles_around(s, v, star);
+      const double before = worst_of_tets(star);
+      const double aligned_before = worst_alignment(s, triangles);
+      const Eigen::Vector3d kept_point = mesh_.points[v];
+      const Eigen::Vector2d kept_uv = projection.uv[node];
+      mesh_.points[v] = point;
+      projection.uv[node] = crossing.at;
+      const bool embedded = std::ranges::all_of(triangles, [&](const std::array<int, 3>& t) {
+        return cross2(projection.uv[t[1]] - projection.uv[t[0]], projection.uv[t[2]] - projection.uv[t[0]]) * projection.orientation > 0.0;
+      });
+      const double after = worst_of_tets(star);
+      const bool aligned = worst_alignment(s, triangles) > aligned_before;
+      mesh_.points[v] = kept_point;
+      projection.uv[node] = kept_uv;
+      if (embedded && aligned && acceptable(after, before) && after > best) {
+        best = after;
+        mover = node;
+      }
+    }
+
+    const int vertices = mesh_.num_vertices();
+    std::optional<Retriangulation> split = crease_split(s, crossing, point, *start);
+    if (split && split->worst_created > best && acceptable(split->worst_created, split->worst_removed) &&
+        split_aligns(s, crossing, split->split_apexes) &&
+        apply(*split)) {
+      add_split_node(s, crossing, split->split_apexes);
+      return true;
+    }
+    drop_vertices_from(vertices);
+    if (mover < 0) return false;
+    mesh_.points[projection.nodes[mover]] = point;
+    projection.uv[mover] = crossing.at;
+    projection.creases.line_of[mover] = crossing.line;
+    projection.creases.parameter[mover] = crossing.s;
+    ++stats_.crease_moves;
+    return true;
+  }
+
+  // Whether a mend whose worst new tet is `created` may replace tets whose worst is `removed`: if it is
+  // valid and not below both `removed` and the floor (crease_floor, or the mesh's worst tet if that is
+  // poorer): the mesh's worst tet never gets worse.
+  bool acceptable(double created, double removed) const {
+    return created > 0.0 && created >= std::min(removed, mend_floor_);
+  }
+
+  double worst_alignment(int s, std::span<const std::array<int, 3>> triangles) const {
+    double worst = 1.0;
+    for (const auto& triangle : triangles) worst = std::min(worst, triangle_alignment(s, triangle));
+    return worst;
+  }
+
+  // Whether the halves of S_M's triangles (a, b, x) at the split's new vertex (the mesh's last, at
+  // crossing.at in P) are better aligned with S than the triangles.
+  bool split_aligns(int s, const CreaseCrossing& crossing, std::span<const VertexId> apexes) const {
+    const SurfaceProjection& projection = *surfaces_[s];
+    const Eigen::Vector3d& m = mesh_.points.back();
+    const Eigen::Vector3d &xa = mesh_.points[projection.nodes[crossing.a]], &xb = mesh_.points[projection.nodes[crossing.b]];
+    const Eigen::Vector2d &ua = projection.uv[crossing.a], &ub = projection.uv[crossing.b];
+    double before = 1.0, after = 1.0;
+    for (VertexId x : apexes) {
+      const Eigen::Vector2d& ux = projection.uv[node_index_[x]];
+      before = std::min(before, triangle_alignment(s, {crossing.a, crossing.b, node_index_[x]}));
+      after = std::min({after, alignment(s, {xa, m, mesh_.points[x]}, (ua + crossing.at + ux) / 3.0),
+                        alignment(s, {m, xb, mesh_.points[x]}, (crossing.at + ub + ux) / 3.0)});
+    }
+    return after > before;
+  }
+
+  // S_M's triangles around its node v (surface s's interface faces among the tets of `star`), oriented.
+  std::vector<std::array<int, 3>> surface_triangles_around(int s, VertexId v, std::span<const TetId> star) const {
+    const SurfaceProjection& projection = *surfaces_[s];
+    const auto& index = triangle_of_[s];
+    std::vector<std::array<int, 3>> triangles;
+    for (TetId t : star)
+      for (int f = 0; f < 4; ++f) {
+        const Tet& tet = mesh_.tets[t];
+        if (tet[f] == v || mesh_.face_tags[t][f] != interface_tag(s)) continue;
+        std::array<int, 3> nodes;
+        for (int k = 0; k < 3; ++k) nodes[k] = node_index_[tet[face_vertices[f][k]]];
+        const std::array<int, 3>& triangle = projection.triangles[index.at(sorted_triangle(nodes))];
+        if (std::ranges::find(triangles, triangle) == triangles.end()) triangles.push_back(triangle);
+      }
+    return triangles;
+  }
+
+  // The split of S_M's edge at `crossing` (surface s; `start` holds the edge): a new vertex at `point` (left in the mesh; the
+  // caller keeps it with add_split_node or drops it), the tets around the edge halved through it, the
+  // tagged faces around the edge halved with their tags. Nothing if a face around the edge lies on the
+  // box or another surface.
+  std::optional<Retriangulation> crease_split(int s, const CreaseCrossing& crossing, const Eigen::Vector3d& point, TetId start) {
+    const SurfaceProjection& projection = *surfaces_[s];
+    const VertexId a = projection.nodes[crossing.a], b = projection.nodes[crossing.b];
+
+    GridPoint grid;
+    for (int k = 0; k < 3; ++k)
+      grid[k] = mesh_.grid[a][k] + std::llround(crossing.r * static_cast<double>(mesh_.grid[b][k] - mesh_.grid[a][k]));
+    const VertexId m = mesh_.add_vertex(point, grid);
+    surface_of_.push_back(s);
+    node_index_.push_back(static_cast<int>(projection.nodes.size()));
+    incident_.push_back(no_tet);
+
+    Retriangulation r;
+    r.removed = tets_around_edge(mesh_, start, a, b);
+    r.worst_removed = worst_of_tets(r.removed);
+    r.worst_created = std::numeric_limits<double>::infinity();
+    std::vector<VertexId>& apexes = r.split_apexes;
+    for (TetId t : r.removed) {
+      const Tet oriented = mesh_.oriented_tet(t);
+      for (VertexId replaced : {a, b}) {
+        Tet created = oriented;
+        created[local_index(oriented, replaced)] = m;
+        r.worst_created = std::min(r.worst_created, new_tet_quality(created));
+        r.created.push_back(created);
+        r.flag_parent.push_back(t);
+      }
+      for (int f = 0; f < 4; ++f) {
+        const VertexId opposite = mesh_.tets[t][f];
+        const FaceTag tag = mesh_.face_tags[t][f];
+        if (opposite == a || opposite == b || tag == no_face_tag) continue;
+        if (mesh_.neighbours[t][f] == no_tet || tag != interface_tag(s)) return std::nullopt;
+        VertexId x = no_tet;
+        for (VertexId v : mesh_.tets[t])
+          if (v != a && v != b && v != opposite) x = v;
+        if (std::ranges::find(apexes, x) != apexes.end()) continue;  // seen from the tet on its other side
+        apexes.push_back(x);
+        r.tagged_faces.push_back({sorted_face({a, m, x, b}, 3), tag});
+        r.tagged_faces.push_back({sorted_face({m, b, x, a}, 3), tag});
+      }
+    }
+    if (apexes.size() != 2) return std::nullopt;
+    return r;
+  }
+
+  // Removes the vertices from `count` on (a split's vertex that was not kept).
+  void drop_vertices_from(int count) {
+    mesh_.points.resize(count);
+    mesh_.grid.resize(count);
+    surface_of_.resize(count);
+    node_index_.resize(count);
+    incident_.resize(count);
+  }
+
+  // After a crease split of surface s's S_M at `crossing`: its new vertex (the mesh's last) becomes an S_M
+  // node on the crease line, and S_M's triangles (a, b, x) become (a, m, x) and (m, b, x).
+  void add_split_node(int s, const CreaseCrossing& crossing, std::span<const VertexId> apexes) {
+    SurfaceProjection& projection = *surfaces_[s];
+    const int node = static_cast<int>(projection.nodes.size());
+    projection.nodes.push_back(mesh_.num_vertices() - 1);
+    projection.uv.push_back(crossing.at);
+    projection.on_rim.push_back(0);
+    projection.creases.line_of.push_back(crossing.line);
+    projection.creases.parameter.push_back(crossing.s);
+    auto& index = triangle_index(s);
+    for (VertexId x : apexes) {
+      const int apex = node_index_[x];
+      const auto old = index.find(sorted_triangle({crossing.a, crossing.b, apex}));
+      if (old == index.end()) throw MeshingError("a crease split did not find S_M's triangle");
+      const int t = old->second;
+      index.erase(old);
+      std::array<int, 3>& triangle = projection.triangles[t];
+      int i = 0;  // triangle = (triangle[i], triangle[i + 1], apex), cyclically
+      while (triangle[(i + 2) % 3] != apex) ++i;
+      const std::array<int, 3> first{triangle[i], node, apex}, second{node, triangle[(i + 1) % 3], apex};
+      triangle = first;
+      index.emplace(sorted_triangle(first), t);
+      index.emplace(sorted_triangle(second), static_cast<int>(projection.triangles.size()));
+      projection.triangles.push_back(second);
+    }
+  }
+
   // For each created tet, the removed tet whose region flags it takes: the one behind its interface faces
   // on the cavity's boundary (so that each interface face keeps V_M on the same side, which orients it),
   // else r.flag_parent. Empty if a created tet's interface faces disagree.
@@ -188,8 +447,10 @@ class Flipper {
   // triangles (i < k < j) of the ring polygon's triangulation whose worst tet is best. When (a, b) is an
   // edge inside S_M, two of the faces around it, (a, b, r_p) and (a, b, r_q), are interface faces: the
   // triangulation must then hold the diagonal (r_p, r_q), whose faces (a, r_p, r_q) and (b, r_p, r_q)
-  // become the interface there (interface_flip decides whether S_M may take them).
-  std::optional<Retriangulation> edge_removal(TetId t, VertexId a, VertexId b) const {
+  // become the interface there (interface_flip decides whether S_M may take them). Nothing unless the
+  // worst new tet beats the worst removed one, or `floor` if that is lower.
+  std::optional<Retriangulation> edge_removal(TetId t, VertexId a, VertexId b,
+                                              double floor = std::numeric_limits<double>::infinity()) const {
     const Tet& first = mesh_.tets[t];
     std::vector<VertexId> ring;
     for (VertexId v : first)
@@ -261,7 +522,7 @@ class Flipper {
         }
     r.worst_created = std::numeric_limits<double>::infinity();
     for (const auto& [lo, hi] : polygons) r.worst_created = std::min(r.worst_created, best[lo][hi]);
-    if (!(r.worst_created > r.worst_removed)) return std::nullopt;
+    if (!(r.worst_created > std::min(r.worst_removed, floor))) return std::nullopt;
     if (q != 0) {
       r.surface_flip = interface_flip(interface_index(interface), a, b, ring[0], ring[q]);
       if (!r.surface_flip) return std::nullopt;
@@ -297,15 +558,8 @@ class Flipper {
     auto orient = [&](int x, int y, int z) { return cross2(uv(y) - uv(x), uv(z) - uv(x)); };
     if (!(orient(np, nq, na) * orient(np, nq, nb) < 0.0) || !(orient(na, nb, np) * orient(na, nb, nq) < 0.0))
       return std::nullopt;
-    auto deviation = [&](int x, int y, int z) {
-      const Eigen::Vector2d centroid = (uv(x) + uv(y) + uv(z)) / 3.0;
-      const Eigen::Matrix<double, 3, 2> tangent = projection.surface->derivative(projection.surface->locate(centroid).triangle);
-      const Eigen::Vector3d normal_of_s = tangent.col(0).cross(tangent.col(1)).normalized();
-      const Eigen::Vector3d& px = mesh_.points[projection.nodes[x]];
-      const Eigen::Vector3d normal = (mesh_.points[projection.nodes[y]] - px).cross(mesh_.points[projection.nodes[z]] - px).normalized();
-      return std::abs(normal.dot(normal_of_s));  // the cosine: larger is better
-    };
-    if (std::min(deviation(np, nq, na), deviation(np, nq, nb)) < std::min(deviation(na, nb, np), deviation(na, nb, nq)))
+    auto alignment = [&](int x, int y, int z) { return triangle_alignment(surface, {x, y, z}); };
+    if (std::min(alignment(np, nq, na), alignment(np, nq, nb)) < std::min(alignment(na, nb, np), alignment(na, nb, nq)))
       return std::nullopt;
     SurfaceFlip flip{surface, {}, {}};
     flip.removed = {sorted_triangle({na, nb, np}), sorted_triangle({na, nb, nq})};
@@ -313,6 +567,25 @@ class Flipper {
     for (auto& triangle : flip.created)
       if ((orient(triangle[0], triangle[1], triangle[2]) > 0.0) != (projection.orientation > 0)) std::swap(triangle[1], triangle[2]);
     return flip;
+  }
+
+  // The cosine between the normal of the triangle with corners x and S's normal at `at` in P (surface s):
+  // 1 where the triangle lies along S.
+  double alignment(int s, const std::array<Eigen::Vector3d, 3>& x, const Eigen::Vector2d& at) const {
+    const ParametricSurface& surface = *surfaces_[s]->surface;
+    const Eigen::Matrix<double, 3, 2> tangent = surface.derivative(surface.locate(at).triangle);
+    return std::abs((x[1] - x[0]).cross(x[2] - x[0]).normalized().dot(tangent.col(0).cross(tangent.col(1)).normalized()));
+  }
+  // The alignment of S_M's triangle over surface s's nodes, at its centroid in P.
+  double triangle_alignment(int s, const std::array<int, 3>& nodes) const {
+    const SurfaceProjection& projection = *surfaces_[s];
+    std::array<Eigen::Vector3d, 3> x;
+    Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      x[k] = mesh_.points[projection.nodes[nodes[k]]];
+      centroid += projection.uv[nodes[k]] / 3.0;
+    }
+    return alignment(s, x, centroid);
   }
 
   static std::array<int, 3> sorted_triangle(std::array<int, 3> triangle) {
@@ -388,10 +661,10 @@ class Flipper {
   // Replaces r.removed by r.created, unless the region flags cannot follow (flag_parents): the created
   // tets inherit the tags and neighbours of the cavity's boundary faces and are each other's neighbours
   // across the faces inside it, tagged as r.tagged_faces says; S_M takes r.surface_flip.
-  void apply(const Retriangulation& r) {
+  bool apply(const Retriangulation& r) {
     const std::vector<BoundaryFace> boundary = cavity_boundary(r.removed);
     const std::vector<TetId> parents = flag_parents(r, boundary);
-    if (parents.empty()) return;
+    if (parents.empty()) return false;
     std::vector<std::vector<std::uint8_t>> flags(regions_.size());
     for (std::size_t k = 0; k < regions_.size(); ++k)
       for (TetId parent : parents) flags[k].push_back((*regions_[k])[parent]);
@@ -401,6 +674,8 @@ class Flipper {
     for (std::size_t i = 0; i < slots.size(); ++i) {
       mesh_.tets[slots[i]] = r.created[i];
       mesh_.kinds[slots[i]] = TetKind::remeshed();
+      if (!incident_.empty())
+        for (VertexId v : r.created[i]) incident_[v] = slots[i];
       for (std::size_t k = 0; k < regions_.size(); ++k) (*regions_[k])[slots[i]] = flags[k][i];
     }
     std::size_t linked = 0;
@@ -429,21 +704,31 @@ class Flipper {
     if (r.surface_flip) flip_surface_triangles(*r.surface_flip);
 
     const auto m = r.removed.size();
-    if (r.surface_flip) ++stats_.surface_edge_flips;
+    if (!r.split_apexes.empty()) ++stats_.crease_splits;
+    else if (r.surface_flip) ++stats_.surface_edge_flips;
     else if (m == 2) ++stats_.flips_2_3;
     else if (m == 3 && r.created.size() == 2) ++stats_.flips_3_2;
     else if (m == 4) ++stats_.flips_4_4;
     else ++stats_.edge_removals;
     stats_.tets_removed += static_cast<std::int64_t>(m);
     stats_.tets_created += static_cast<std::int64_t>(r.created.size());
+    return true;
+  }
+
+  // Surface s's S_M triangles by their sorted node indices, built when first needed.
+  std::map<std::array<int, 3>, int>& triangle_index(int s) {
+    if (triangle_of_.empty()) triangle_of_.resize(surfaces_.size());
+    auto& index = triangle_of_[s];
+    if (index.empty()) {
+      const auto& triangles = surfaces_[s]->triangles;
+      for (int t = 0; t < static_cast<int>(triangles.size()); ++t) index.emplace(sorted_triangle(triangles[t]), t);
+    }
+    return index;
   }
 
   void flip_surface_triangles(const SurfaceFlip& flip) {
     std::vector<std::array<int, 3>>& triangles = surfaces_[flip.surface]->triangles;
-    if (triangle_of_.empty()) triangle_of_.resize(surfaces_.size());
-    auto& index = triangle_of_[flip.surface];
-    if (index.empty())
-      for (int t = 0; t < static_cast<int>(triangles.size()); ++t) index.emplace(sorted_triangle(triangles[t]), t);
+    auto& index = triangle_index(flip.surface);
     for (int k = 0; k < 2; ++k) {
       const auto old = index.find(flip.removed[k]);
       if (old == index.end()) throw MeshingError("an edge flip inside S_M did not find S_M's triangle");
@@ -487,8 +772,10 @@ class Flipper {
   const ImprovementOptions& options_;
   std::vector<int> surface_of_;  // the surface whose S_M holds each vertex, or -1
   std::vector<int> node_index_;  // each S_M vertex's index in its surface's nodes, or -1
-  // Per surface, S_M's triangles by their sorted node indices: built at the first flip inside S_M.
+  // Per surface, S_M's triangles by their sorted node indices (triangle_index).
   std::vector<std::map<std::array<int, 3>, int>> triangle_of_;
+  std::vector<TetId> incident_;  // while mending creases: a tet holding each vertex
+  double mend_floor_ = 0.0;      // while mending creases: see acceptable()
   std::vector<TetId> free_;      // slots of removed tets not yet reused
   std::vector<TetId> created_;   // the slots filled by this pass's flips
   FlipStats stats_;
@@ -498,8 +785,8 @@ class Flipper {
 
 // Every count of FlipStats, for the arithmetic below.
 constexpr std::array flip_counts{&FlipStats::flips_2_3,     &FlipStats::flips_3_2,          &FlipStats::flips_4_4,
-                                 &FlipStats::edge_removals, &FlipStats::surface_edge_flips, &FlipStats::tets_removed,
-                                 &FlipStats::tets_created};
+                                 &FlipStats::edge_removals, &FlipStats::surface_edge_flips, &FlipStats::crease_splits,
+                                 &FlipStats::crease_moves,  &FlipStats::tets_removed,       &FlipStats::tets_created};
 
 FlipStats& FlipStats::operator+=(const FlipStats& other) {
   for (auto count : flip_counts) this->*count += other.*count;
@@ -514,12 +801,19 @@ FlipStats operator-(FlipStats a, const FlipStats& b) {
 std::string describe(const FlipStats& flips) {
   return std::to_string(flips.flips_2_3) + " 2-3, " + std::to_string(flips.flips_3_2) + " 3-2, " +
          std::to_string(flips.flips_4_4) + " 4-4 flips, " + std::to_string(flips.edge_removals) +
-         " larger edge removals, " + std::to_string(flips.surface_edge_flips) + " edge flips inside S_M";
+         " larger edge removals, " + std::to_string(flips.surface_edge_flips) + " edge flips inside S_M, " +
+         std::to_string(flips.crease_moves) + " S_M nodes moved onto creases, " + std::to_string(flips.crease_splits) +
+         " S_M edges split at creases";
 }
 
 FlipStats flip_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
                           std::span<TetRegion* const> regions, const ImprovementOptions& options) {
   return Flipper(mesh, surfaces, regions, options).run();
+}
+
+FlipStats conform_to_creases(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
+                             std::span<TetRegion* const> regions, const ImprovementOptions& options) {
+  return Flipper(mesh, surfaces, regions, options).conform_to_creases();
 }
 
 }  // namespace meccano

@@ -93,7 +93,7 @@ void write_improvement(JsonWriter& json, const ImprovementStats& s, double secon
   json.key("operations").begin_object();
   json.key("flips_2_3").value(s.flips.flips_2_3).key("flips_3_2").value(s.flips.flips_3_2);
   json.key("flips_4_4").value(s.flips.flips_4_4).key("edge_removals").value(s.flips.edge_removals);
-  json.key("surface_edge_flips").value(s.flips.surface_edge_flips).end_object();
+  json.key("surface_edge_flips").value(s.flips.surface_edge_flips).key("crease_splits").value(s.flips.crease_splits).key("crease_moves").value(s.flips.crease_moves).end_object();
   json.key("tets_removed").value(s.flips.tets_removed).key("tets_created").value(s.flips.tets_created);
   json.key("remeshed_tets").value(s.remeshed_tets);
   json.key("seconds").value(seconds).end_object();

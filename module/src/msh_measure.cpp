@@ -107,6 +107,38 @@ double sampled_distance(const TriangleBVH& from, const TriangleBVH& to) {
   return std::sqrt(largest2);
 }
 
+
+bool is_interface(const MshGroup& group) { return group.dimension == 2 && group.name.starts_with("interface_"); }
+
+std::string surface_label(const TriangleSurface& surface) {
+  return "surface " + surface.name + (surface.source.empty() ? "" : " (" + surface.source + ")");
+}
+
+// The surface each interface group is compared with, by group; InputError for a surface that matches no
+// group or the group of another surface.
+std::vector<const TriangleSurface*> match_surfaces(const MshMesh& mesh, std::span<const TriangleSurface> surfaces) {
+  std::vector<const TriangleSurface*> matched(mesh.groups.size(), nullptr);
+  std::string interface_names;
+  for (const MshGroup& group : mesh.groups)
+    if (is_interface(group)) interface_names += (interface_names.empty() ? "" : ", ") + group.name;
+  for (const TriangleSurface& surface : surfaces) {
+    const std::string name = "interface_" + surface.name;
+    const auto group = std::ranges::find_if(mesh.groups, [&](const MshGroup& g) { return is_interface(g) && g.name == name; });
+    if (group == mesh.groups.end())
+      throw InputError(surface_label(surface) + ": " + mesh.source + " has no 2D group " + name +
+                       " (its interface groups: " + (interface_names.empty() ? "none" : interface_names) + ")");
+    const TriangleSurface*& slot = matched[group - mesh.groups.begin()];
+    if (slot) throw InputError(surface_label(surface) + " and " + surface_label(*slot) + " are both named " + surface.name);
+    if (surface.triangles.empty()) throw InputError(surface_label(surface) + " has no triangles");
+    if (group->elements.empty())
+      throw InputError(mesh.source + ": group " + name + " has no triangles to compare with " + surface_label(surface));
+    slot = &surface;
+  }
+  return matched;
+}
+
+}  // namespace
+
 SurfaceAccuracy accuracy_against(const TriangleSurface& interface, const TriangleSurface& surface) {
   const TriangleBVH on_surface(surface), on_interface(interface);
   SurfaceAccuracy accuracy;
@@ -147,37 +179,6 @@ SurfaceAccuracy accuracy_against(const TriangleSurface& interface, const Triangl
   accuracy.area_ratio = static_cast<double>(total) / area_of(surface);
   return accuracy;
 }
-
-bool is_interface(const MshGroup& group) { return group.dimension == 2 && group.name.starts_with("interface_"); }
-
-std::string surface_label(const TriangleSurface& surface) {
-  return "surface " + surface.name + (surface.source.empty() ? "" : " (" + surface.source + ")");
-}
-
-// The surface each interface group is compared with, by group; InputError for a surface that matches no
-// group or the group of another surface.
-std::vector<const TriangleSurface*> match_surfaces(const MshMesh& mesh, std::span<const TriangleSurface> surfaces) {
-  std::vector<const TriangleSurface*> matched(mesh.groups.size(), nullptr);
-  std::string interface_names;
-  for (const MshGroup& group : mesh.groups)
-    if (is_interface(group)) interface_names += (interface_names.empty() ? "" : ", ") + group.name;
-  for (const TriangleSurface& surface : surfaces) {
-    const std::string name = "interface_" + surface.name;
-    const auto group = std::ranges::find_if(mesh.groups, [&](const MshGroup& g) { return is_interface(g) && g.name == name; });
-    if (group == mesh.groups.end())
-      throw InputError(surface_label(surface) + ": " + mesh.source + " has no 2D group " + name +
-                       " (its interface groups: " + (interface_names.empty() ? "none" : interface_names) + ")");
-    const TriangleSurface*& slot = matched[group - mesh.groups.begin()];
-    if (slot) throw InputError(surface_label(surface) + " and " + surface_label(*slot) + " are both named " + surface.name);
-    if (surface.triangles.empty()) throw InputError(surface_label(surface) + " has no triangles");
-    if (group->elements.empty())
-      throw InputError(mesh.source + ": group " + name + " has no triangles to compare with " + surface_label(surface));
-    slot = &surface;
-  }
-  return matched;
-}
-
-}  // namespace
 
 const InterfaceMeasure* MeshMeasure::find(const std::string& name) const {
   const auto found = std::ranges::find(interfaces, name, &InterfaceMeasure::name);

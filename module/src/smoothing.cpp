@@ -848,7 +848,9 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
     return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})
         .improve(options, only);
   };
+  const FlipStats splits = options.topology ? conform_to_creases(mesh, surfaces, regions, options) : FlipStats{};
   ImprovementStats stats = smooth({});
+  stats.flips += splits;
   if (!options.topology) return stats;
   for (int round = 0; round < options.rounds; ++round) {
     const FlipStats flips = flip_worst_tets(mesh, surfaces, regions, options);

@@ -79,6 +79,21 @@ struct CreaseNodes {
   CreaseStats stats;
 };
 
+// A point of P where a crease line crosses an S_M edge between its nodes, neither of which lies on that
+// line: S_M's triangles on both sides of the edge straddle the crease there.
+struct CreaseCrossing {
+  int line;
+  double s;            // arc length along the line
+  int a, b;            // the edge's nodes (indices of S_M's nodes)
+  double r;            // where the crossing lies on the edge: uv[a] + r (uv[b] - uv[a])
+  Eigen::Vector2d at;  // the point of P
+};
+
+// Every such crossing of `creases`' lines with the edges of S_M's `triangles` at parameters `uv`, in the
+// order of the lines and along each line.
+std::vector<CreaseCrossing> straddling_crossings(const CreaseNodes& creases, std::span<const std::array<int, 3>> triangles,
+                                                 std::span<const Eigen::Vector2d> uv);
+
 // Snaps S_M's nodes onto the crease lines (see the header comment); `uv` (per S_M node) is updated.
 // `triangles` are S_M's over node ids, `on_rim` flags its rim nodes, `orientation` (+1 or -1) is the sign
 // of its triangles' areas in P.

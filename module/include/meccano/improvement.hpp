@@ -65,8 +65,12 @@ struct FlipStats {
   std::int64_t flips_2_3 = 0, flips_3_2 = 0, flips_4_4 = 0;
   std::int64_t edge_removals = 0;                 // rings of 5 or more tets
   std::int64_t surface_edge_flips = 0;            // edge removals inside S_M: two interface triangles flipped
+  std::int64_t crease_splits = 0;                 // S_M edges split where a crease of S crosses them
+  std::int64_t crease_moves = 0;                  // S_M nodes moved onto a crease that crossed their edge
   std::int64_t tets_removed = 0, tets_created = 0;
-  std::int64_t operations() const { return flips_2_3 + flips_3_2 + flips_4_4 + edge_removals + surface_edge_flips; }
+  std::int64_t operations() const {
+    return flips_2_3 + flips_3_2 + flips_4_4 + edge_removals + surface_edge_flips + crease_splits + crease_moves;
+  }
   FlipStats& operator+=(const FlipStats& other);
 };
 FlipStats operator-(FlipStats a, const FlipStats& b);
@@ -97,5 +101,12 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
 // between its smoothing passes with options.topology.
 FlipStats flip_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
                           std::span<TetRegion* const> regions = {}, const ImprovementOptions& options = {});
+
+// What improve_worst_tets does first with options.topology: every S_M edge that a crease line of S crosses
+// between its nodes (creases.hpp, straddling_crossings) is mended, by moving one of its nodes onto the
+// crossing or by splitting it there, whichever leaves the best worst tet, unless a tet would be inverted
+// or poorer than both 0.1 and the worst tet it changes.
+FlipStats conform_to_creases(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
+                             std::span<TetRegion* const> regions = {}, const ImprovementOptions& options = {});
 
 }  // namespace meccano

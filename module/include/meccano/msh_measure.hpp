@@ -93,6 +93,10 @@ struct MeshMeasure {
 
 MeshMeasure measure_msh_mesh(const MshMesh& mesh, std::span<const TriangleSurface> surfaces = {});
 
+// The accuracy of an interface (its faces as a triangle surface, oriented like S) against S: what
+// measure_msh_mesh reports for an interface group whose surface was given.
+SurfaceAccuracy accuracy_against(const TriangleSurface& interface, const TriangleSurface& surface);
+
 // read_msh_mesh then measure_msh_mesh.
 MeshMeasure measure_mesh_file(const std::string& path, std::span<const TriangleSurface> surfaces = {});
 

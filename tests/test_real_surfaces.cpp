@@ -93,8 +93,8 @@ TEST_P(RealSurface, IsInsertedValidFaithfulAndAsEstimated) {
 INSTANTIATE_TEST_SUITE_P(
     FastSubset, RealSurface,
     ::testing::Values(RealCase{"East_Huasna_E50", "CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts", true, 50, 20},
-                      RealCase{"Pipes_Canyon_E30", "MJVA-HSLZ-SBMT-Pipes_Canyon_fault_north_extension-CFM5_1000m.ts", true, 30, 36},
-                      RealCase{"Malibu_Coast_E30", "WTRA-SFFS-ANCP-Malibu_Coast_fault_west_steep_alt2-CFM5_1000m.ts", true, 30, 29},
+                      RealCase{"Pipes_Canyon_E30", "MJVA-HSLZ-SBMT-Pipes_Canyon_fault_north_extension-CFM5_1000m.ts", true, 30, 25},
+                      RealCase{"Malibu_Coast_E30", "WTRA-SFFS-ANCP-Malibu_Coast_fault_west_steep_alt2-CFM5_1000m.ts", true, 30, 18},
                       RealCase{"creased_E30", hard_surface("creased.obj"), false, 30, 25},
                       RealCase{"low_dip_E30", hard_surface("low_dip.obj"), false, 30, 6},
                       RealCase{"thin_long_E30", hard_surface("thin_long.obj"), false, 30, 3},

@@ -30,11 +30,16 @@
 //          (TetKind::bisectable() is false): the bisection hierarchy ends there, and their paper's measure
 //          is taken against the equilateral tet. Serial, in a fixed order: the result does not depend on
 //          the thread count.
+// Creases  (options.topology) first, before any smoothing pass: S_M edges that a crease of S still crosses
+//          (creases.hpp) are mended, by an edge flip inside S_M along the crease, by moving an end of the
+//          edge onto it, or by splitting the edge there (a new S_M node on the crease, the tets around the
+//          edge halved), when that aligns S_M's triangles there better with S and leaves no tet below both
+//          what it replaces and max(0.1, the mesh's worst): conform_to_creases.
 // Output   the improved mesh, still valid and conforming, its S_M nodes still on S; statistics. With
 //          `smooth` the topology and the bisection hierarchy are untouched.
 // Limits   a tet whose four nodes cannot move and that no flip improves (box corners, nodes of two
-//          surfaces, shapes fixed by S's own triangles) stays as it is; no vertex insertion, edge
-//          contraction or multi-face removal, and no flips of box or interface faces.
+//          surfaces, shapes fixed by S's own triangles) stays as it is; no edge contraction, multi-face
+//          removal or vertex insertion away from creases, and no flips of box faces.
 #pragma once
 
 #include <meccano/projection.hpp>

@@ -4,12 +4,13 @@
 #include <meccano/error.hpp>
 #include <meccano/surface_validation.hpp>
 
+#include "topology_helpers.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
 #include <cstddef>
-#include <numeric>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -38,26 +39,6 @@ std::string format_number(double value) {
   return out.str();
 }
 
-class DisjointSets {
- public:
-  explicit DisjointSets(std::size_t count) : parent_(count) { std::iota(parent_.begin(), parent_.end(), 0); }
-  int find(int i) {
-    while (parent_[static_cast<std::size_t>(i)] != i) {
-      int& parent = parent_[static_cast<std::size_t>(i)];
-      parent = parent_[static_cast<std::size_t>(parent)];  // path halving
-      i = parent;
-    }
-    return i;
-  }
-  void unite(int a, int b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent_[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
-  }
-
- private:
-  std::vector<int> parent_;
-};
 
 // One side of an edge: the triangle and whether it traverses the edge from its lower to its higher vertex.
 struct EdgeSide {
@@ -188,18 +169,18 @@ void check_consistent_orientation(const TriangleSurface& surface, const std::vec
 
 // Triangles sharing a vertex are connected: a bow-tie is one component with a non-manifold vertex.
 void check_single_component(const TriangleSurface& surface) {
-  DisjointSets sets(surface.points.size());
+  detail::UnionFind sets(surface.points.size());
   for (const Triangle& triangle : surface.triangles) {
-    sets.unite(triangle[0], triangle[1]);
-    sets.unite(triangle[0], triangle[2]);
+    sets.join(triangle[0], triangle[1]);
+    sets.join(triangle[0], triangle[2]);
   }
   std::vector<bool> seen(surface.points.size(), false);
   int components = 0;
   std::size_t second_component_triangle = 0;
   for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
-    const int root = sets.find(surface.triangles[t][0]);
-    if (seen[static_cast<std::size_t>(root)]) continue;
-    seen[static_cast<std::size_t>(root)] = true;
+    const std::size_t root = sets.find(surface.triangles[t][0]);
+    if (seen[root]) continue;
+    seen[root] = true;
     if (++components == 2) second_component_triangle = t;
   }
   if (components > 1)
@@ -216,11 +197,11 @@ void check_manifold_vertices(const TriangleSurface& surface, const std::vector<E
     const Triangle& triangle = triangles[static_cast<std::size_t>(t)];
     return 3 * t + static_cast<int>(std::ranges::find(triangle, vertex) - triangle.begin());
   };
-  DisjointSets fans(3 * triangles.size());
+  detail::UnionFind fans(3 * triangles.size());
   for_each_edge(sides, [&](std::size_t first, std::size_t count) {
     if (count != 2) return;
     for (const int vertex : {sides[first].low, sides[first].high})
-      fans.unite(corner(sides[first].triangle, vertex), corner(sides[first + 1].triangle, vertex));
+      fans.join(corner(sides[first].triangle, vertex), corner(sides[first + 1].triangle, vertex));
   });
   std::vector<int> fan_of_vertex(surface.points.size(), -1);
   std::vector<int> triangle_of_vertex(surface.points.size(), -1);
@@ -229,7 +210,7 @@ void check_manifold_vertices(const TriangleSurface& surface, const std::vector<E
   for (std::size_t t = 0; t < triangles.size(); ++t)
     for (std::size_t k = 0; k < 3; ++k) {
       const int vertex = triangles[t][k];
-      const int fan = fans.find(3 * static_cast<int>(t) + static_cast<int>(k));
+      const auto fan = static_cast<int>(fans.find(3 * t + k));
       int& known = fan_of_vertex[static_cast<std::size_t>(vertex)];
       if (known < 0) {
         known = fan;
@@ -242,7 +223,7 @@ void check_manifold_vertices(const TriangleSurface& surface, const std::vector<E
   if (pinched < 0) return;
   std::vector<int> fan_roots;
   for (std::size_t c = 0; c < 3 * triangles.size(); ++c)
-    if (triangles[c / 3][c % 3] == pinched) fan_roots.push_back(fans.find(static_cast<int>(c)));
+    if (triangles[c / 3][c % 3] == pinched) fan_roots.push_back(static_cast<int>(fans.find(c)));
   std::ranges::sort(fan_roots);
   const auto fan_count = std::ranges::distance(fan_roots.begin(), std::unique(fan_roots.begin(), fan_roots.end()));
   fail(surface, "non-manifold " + vertex_name(pinched) + ": its triangles form " + std::to_string(fan_count) +
@@ -252,20 +233,20 @@ void check_manifold_vertices(const TriangleSurface& surface, const std::vector<E
 }
 
 void check_disk(const TriangleSurface& surface, const std::vector<EdgeSide>& sides) {
-  DisjointSets loops(surface.points.size());
+  detail::UnionFind loops(surface.points.size());
   std::vector<int> boundary_vertices;
   long long edges = 0;
   for_each_edge(sides, [&](std::size_t first, std::size_t count) {
     ++edges;
     if (count != 1) return;
-    loops.unite(sides[first].low, sides[first].high);
+    loops.join(sides[first].low, sides[first].high);
     boundary_vertices.push_back(sides[first].low);
   });
   if (boundary_vertices.empty())
     fail(surface, "closed surface (no boundary edges): an open surface with one boundary loop is required");
   // Manifold vertices make the boundary a disjoint union of loops, one set of vertices per loop.
   std::vector<int> loop_roots;
-  for (const int vertex : boundary_vertices) loop_roots.push_back(loops.find(vertex));
+  for (const int vertex : boundary_vertices) loop_roots.push_back(static_cast<int>(loops.find(vertex)));
   std::ranges::sort(loop_roots);
   const auto loop_count = std::ranges::distance(loop_roots.begin(), std::unique(loop_roots.begin(), loop_roots.end()));
   if (loop_count != 1)

@@ -1,5 +1,6 @@
 // Small helpers shared by the stages that reason about the topology of regions and surfaces of the
-// mesh and of S (volumetric_approximation.cpp, surface_approximation.cpp, creases.cpp, pipeline.cpp).
+// mesh and of S (volumetric_approximation.cpp, surface_approximation.cpp, creases.cpp, pipeline.cpp,
+// surface_validation.cpp).
 // Internal: not installed.
 #pragma once
 

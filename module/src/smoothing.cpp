@@ -848,9 +848,10 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
     return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})
         .improve(options, only);
   };
-  const FlipStats splits = options.topology ? conform_to_creases(mesh, surfaces, regions, options) : FlipStats{};
+  const FlipStats mends = options.topology ? conform_to_creases(mesh, surfaces, regions, options) : FlipStats{};
+  if (options.topology && options.progress) options.progress("improvement creases: " + describe(mends));
   ImprovementStats stats = smooth({});
-  stats.flips += splits;
+  stats.flips += mends;
   if (!options.topology) return stats;
   for (int round = 0; round < options.rounds; ++round) {
     const FlipStats flips = flip_worst_tets(mesh, surfaces, regions, options);

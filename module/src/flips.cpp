@@ -245,20 +245,20 @@ class Flipper {
       const VertexId v = projection.nodes[node];
       const std::vector<TetId> star = star_of(v);
       const std::vector<std::array<int, 3>> triangles = surface_triangles_around(s, v, star);
+      const bool embedded = std::ranges::all_of(
+          triangles, [&](const std::array<int, 3>& t) { return keeps_orientation(projection, t, node, crossing.at); });
+      if (!embedded) continue;
       const double before = worst_of_tets(star);
       const double aligned_before = worst_alignment(s, triangles);
       const Eigen::Vector3d kept_point = mesh_.points[v];
       const Eigen::Vector2d kept_uv = projection.uv[node];
       mesh_.points[v] = point;
       projection.uv[node] = crossing.at;
-      const bool embedded = std::ranges::all_of(triangles, [&](const std::array<int, 3>& t) {
-        return cross2(projection.uv[t[1]] - projection.uv[t[0]], projection.uv[t[2]] - projection.uv[t[0]]) * projection.orientation > 0.0;
-      });
       const double after = worst_of_tets(star);
       const bool aligned = worst_alignment(s, triangles) > aligned_before;
       mesh_.points[v] = kept_point;
       projection.uv[node] = kept_uv;
-      if (embedded && aligned && acceptable(after, before) && after > best) {
+      if (aligned && acceptable(after, before) && after > best) {
         best = after;
         mover = node;
       }

@@ -545,12 +545,8 @@ bool Smoother::move(VertexId v, const Placement& from, const Parameters& step, P
 bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& uv) const {
   const SurfaceProjection& projection = *surfaces_[node.surface];
   const auto& start = triangle_start_[node.surface];
-  for (int k = start[node.index]; k < start[node.index + 1]; ++k) {
-    std::array<Vector2d, 3> corner;
-    const auto& triangle = projection.triangles[node_triangles_[node.surface][k]];
-    for (int c = 0; c < 3; ++c) corner[c] = triangle[c] == node.index ? uv : projection.uv[triangle[c]];
-    if (cross2(corner[1] - corner[0], corner[2] - corner[0]) * projection.orientation <= 0.0) return false;
-  }
+  for (int k = start[node.index]; k < start[node.index + 1]; ++k)
+    if (!keeps_orientation(projection, projection.triangles[node_triangles_[node.surface][k]], node.index, uv)) return false;
   return true;
 }
 

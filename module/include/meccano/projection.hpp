@@ -24,6 +24,7 @@
 #include <meccano/tet_mesh.hpp>
 #include <meccano/volumetric_approximation.hpp>
 
+#include <array>
 #include <memory>
 
 namespace meccano {
@@ -53,6 +54,11 @@ struct SurfaceProjection {
   CreaseNodes creases;                         // which nodes lie on a crease line of S, and where
   ProjectionStats stats;
 };
+
+// Whether S_M's triangle (indices of `projection.nodes`) keeps S_M's orientation in P with its node `moved`
+// at `uv` (the others at their parameters): what steps 3-4 and the improvement keep for every triangle.
+bool keeps_orientation(const SurfaceProjection& projection, const std::array<int, 3>& triangle, int moved,
+                       const Eigen::Vector2d& uv);
 
 SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,
                                        const TriangleSurface& surface, const TriangleBVH& tree,

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The main job: set up the machine, build, and run the paper's cube example through the whole method.
-# Inserts meshes/cube_example.obj (a smooth curved patch inside the unit cube, see meshes/README.md)
+# Inserts meshes/cube_example.obj (a smooth curved patch inside the unit cube, made by meshes/generate_surfaces.py)
 # into the unit-cube meccano mesh at l_r = 0.03 with all four steps, and writes to out/:
 #   cube_example.msh                the result: untangled, smoothed, S_M tagged as interface_patch
 #   cube_example_report.json        timings, counts and quality before and after smoothing

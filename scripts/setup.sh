@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev                       # the module's only library dependency (with OpenMP)
   libgtest-dev libbenchmark-dev       # tests and benchmarks
   libgmsh-dev gmsh                    # independent MSH reader in the tests, reference meshes
-  libtet1.5-dev tetgen                # the TetGen reference mesher (meshes/reference-tetgen)
+  libtet1.5-dev tetgen                # the TetGen reference mesher (reference/reference-tetgen)
   libdeal.ii-dev                      # the adapter meccano::dealii and the demo solver: deal.II with Trilinos and MPI
   python3-dolfinx python3-gmsh        # the user guide's dolfinx example, run by CTest (tests/dolfinx/)
   python3 python3-matplotlib python3-numpy   # plots in doc/

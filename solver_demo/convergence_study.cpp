@@ -6,10 +6,10 @@
 #include "cube_example.hpp"
 #include "interface_poisson.hpp"
 
-#include <meccano/atomic_file.hpp>
-#include <meccano/cube_meccano.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/surface_validation.hpp>
+#include <meccano/io/atomic_file.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/surface/validation.hpp>
 
 #include <deal.II/base/mpi.h>
 

@@ -19,7 +19,7 @@
 
 #include "interface_triangles.hpp"
 
-#include <meccano/surface.hpp>
+#include <meccano/surface/triangle_surface.hpp>
 
 #include <Eigen/Core>
 

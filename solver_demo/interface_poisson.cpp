@@ -3,7 +3,7 @@
 
 #include "interface_poisson.hpp"
 
-#include <meccano/atomic_file.hpp>
+#include <meccano/io/atomic_file.hpp>
 
 #include <deal.II/base/function.h>
 #include <deal.II/base/quadrature_lib.h>

@@ -1,6 +1,6 @@
 #include "interface_triangles.hpp"
 
-#include <meccano/atomic_file.hpp>
+#include <meccano/io/atomic_file.hpp>
 
 #include <array>
 #include <map>

@@ -5,9 +5,9 @@
 #include "cube_example.hpp"
 #include "interface_poisson.hpp"
 
-#include <meccano/atomic_file.hpp>
+#include <meccano/io/atomic_file.hpp>
 #include <meccano/error.hpp>
-#include <meccano/json_writer.hpp>
+#include <meccano/report/json_writer.hpp>
 
 #include <deal.II/base/mpi.h>
 

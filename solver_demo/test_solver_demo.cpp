@@ -6,11 +6,11 @@
 #include "cube_example.hpp"
 #include "interface_triangles.hpp"
 
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh_io.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/surface.hpp>
+#include <meccano/io/mesh_writers.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/io/surface_readers.hpp>
 
 #include <run_command.hpp>
 #include <scratch_directory.hpp>

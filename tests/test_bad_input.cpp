@@ -35,11 +35,11 @@
 // | write failing midway (several outputs) | "cannot write PATH: File too large"                  | CliTest.AFailedWriteRemovesTheFilesTheRunWrote        |
 // | full disk (no partial file left)       | "cannot write PATH: File too large"                  | BadInput.AFullDiskLeavesNoPartialFile                 |
 
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh_io.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/surface.hpp>
+#include <meccano/io/mesh_writers.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/io/surface_readers.hpp>
 
 #include <scratch_directory.hpp>
 #include <test_surfaces.hpp>

@@ -1,11 +1,11 @@
 // Kossaczky bisection on the cube meccano: conformity, exact volume, orientation, similarity classes,
 // local refinement cost, edge splitting and face-tag inheritance.
 
-#include <meccano/bisection.hpp>
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/bisection.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh_check.hpp>
-#include <meccano/quality.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/mesh/quality.hpp>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>

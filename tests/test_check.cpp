@@ -3,10 +3,10 @@
 // MSH 2.2/4.1, ASCII/binary) pass, and corrupted meshes fail with the right reason; the reader's errors
 // name the file, the place and the defect; the command's exit statuses and report.
 
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/msh_check.hpp>
-#include <meccano/pipeline.hpp>
+#include <meccano/inspect/mesh_file_check.hpp>
+#include <meccano/stages/pipeline.hpp>
 
 #include <run_command.hpp>
 #include <test_surfaces.hpp>

@@ -2,8 +2,8 @@
 // Medit) and the tests' VTU reader, and bad input that must fail with its own message and leave no file
 // behind.
 
-#include <meccano/geometry.hpp>
-#include <meccano/surface.hpp>
+#include <meccano/geometry/geometry.hpp>
+#include <meccano/io/surface_readers.hpp>
 
 #include <run_command.hpp>
 #include <scratch_directory.hpp>

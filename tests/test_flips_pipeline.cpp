@@ -1,16 +1,17 @@
-// Flips through the pipeline (`Improvement::topology`, improvement.hpp), on the irregular S_M of the
+// Flips through the pipeline (`Improvement::topology`, stages/improvement.hpp), on the irregular S_M of the
 // perturbed test surfaces at a threshold above the default, for hundreds of flips: the interface keeps its
 // orientation, S_M's triangle list stays the tagged faces, its nodes stay on S, no tet lies on one
 // surface, and the mesh is the same on 1 and 2 threads. The crease mends on a real fault. About a minute:
 // label `long`.
 
-#include <meccano/cube_meccano.hpp>
-#include <meccano/geometry.hpp>
-#include <meccano/improvement.hpp>
-#include <meccano/mesh_check.hpp>
-#include <meccano/msh_measure.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/quality.hpp>
+#include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/geometry/geometry.hpp>
+#include <meccano/stages/improvement.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/inspect/mesh_file_measure.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/mesh/quality.hpp>
 
 #include <test_surfaces.hpp>
 
@@ -77,7 +78,7 @@ TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
     const InsertionResult flipped = insert_surfaces(make_cube_meccano(c.box, 0), c.surfaces, options);
     ASSERT_TRUE(flipped.improvement.has_value());
     surface_edge_flips += flipped.improvement->flips.surface_edge_flips;
-    const MeshCheckReport check = verify_mesh(flipped.mesh, {.physical = true});
+    const MeshInvariantReport check = verify_mesh(flipped.mesh, {.physical = true});
     ASSERT_TRUE(check.ok()) << check.summary();
     EXPECT_GE(flipped.quality_after_smoothing.equilateral.min, smoothed.improvement->min_quality_before);
     EXPECT_EQ(flipped.improvement->remeshed_tets,

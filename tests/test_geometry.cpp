@@ -1,5 +1,5 @@
 // Geometric predicates and the BVH, checked against brute force on real surfaces.
-#include <meccano/geometry.hpp>
+#include <meccano/geometry/geometry.hpp>
 
 #include "test_surfaces.hpp"
 

@@ -1,18 +1,18 @@
-// Lifting the worst tets after SUS (improvement.hpp): slivers made on purpose are lifted, the equilateral
+// Lifting the worst tets after SUS (stages/improvement.hpp): slivers made on purpose are lifted, the equilateral
 // minimum never falls and the meccano one not below min(before, threshold), box nodes stay on their sides,
 // the result does not depend on the thread count, and on real insertions the S_M nodes stay on S
 // (test_smoothing and test_real_surfaces run the pipeline, which improves by default). Flips: the mesh
 // stays conforming with its box sides tagged and flipped tets leave the bisection hierarchy
 // (test_flips_pipeline runs them through the pipeline).
 
-#include <meccano/bisection.hpp>
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/bisection.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/geometry.hpp>
-#include <meccano/improvement.hpp>
-#include <meccano/mesh_check.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/quality.hpp>
+#include <meccano/geometry/geometry.hpp>
+#include <meccano/stages/improvement.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/mesh/quality.hpp>
 
 #include <test_surfaces.hpp>
 
@@ -155,7 +155,7 @@ TEST(Flips, MendSliversWithoutTouchingTheBoxAndEndTheHierarchyWhereTheyAct) {
 
   const FlipStats stats = flip_worst_tets(mesh, {});
   const QualitySummary after = summarize_quality(mesh);
-  const MeshCheckReport check = verify_mesh(mesh, {.physical = true});
+  const MeshInvariantReport check = verify_mesh(mesh, {.physical = true});
   EXPECT_TRUE(check.ok()) << check.summary();
   EXPECT_GT(stats.operations(), 0);
   EXPECT_GT(stats.flips_2_3 + stats.flips_3_2, 0);

@@ -1,11 +1,12 @@
-// The library call a solver uses (pipeline.hpp): insert_surfaces with its options, and
+// The library call a solver uses (stages/pipeline.hpp): insert_surfaces with its options, and
 // surface_interfaces, each surface's faces with the tets on both sides and one consistent normal.
 
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/geometry.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/volumetric_approximation.hpp>
+#include <meccano/geometry/geometry.hpp>
+#include <meccano/report/insertion_report.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/stages/volumetric_approximation.hpp>
 
 #include <test_surfaces.hpp>
 

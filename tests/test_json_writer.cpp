@@ -1,7 +1,7 @@
 // The report JSON writer: layout, escaping, numbers that read back exactly, null for non-finite
 // doubles, and misuse reported as std::logic_error.
 
-#include <meccano/json_writer.hpp>
+#include <meccano/report/json_writer.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,14 +1,14 @@
-// The measurements of any MSH mesh (`meccano-immerse measure`, msh_measure.hpp): on the module's own mesh
+// The measurements of any MSH mesh (`meccano-immerse measure`, inspect/mesh_file_measure.hpp): on the module's own mesh
 // they agree with the insertion's report and with the method's guarantees (nodes on S, faces oriented like
 // S); on hand-made meshes whose answers are known exactly (a square patch against a shifted, flipped or
 // larger square; a regular tet beside an inverted one) they give those answers; the command's report is
 // the library's, and its errors name the files.
 
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh_io.hpp>
-#include <meccano/msh_measure.hpp>
-#include <meccano/pipeline.hpp>
+#include <meccano/io/mesh_writers.hpp>
+#include <meccano/inspect/mesh_file_measure.hpp>
+#include <meccano/stages/pipeline.hpp>
 
 #include <run_command.hpp>
 #include <scratch_directory.hpp>

@@ -3,10 +3,10 @@
 // orientation and qualities must match the mesh written. Also the atomic-write guarantee and the
 // rejection of unknown formats and invalid groups.
 
-#include <meccano/atomic_file.hpp>
-#include <meccano/cube_meccano.hpp>
+#include <meccano/io/atomic_file.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh_io.hpp>
+#include <meccano/io/mesh_writers.hpp>
 
 #include <vtu_reader.hpp>
 

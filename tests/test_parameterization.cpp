@@ -1,8 +1,8 @@
 // Floater parameterizations onto the unit square, corner matching and the composed projection
 // φ(φ_M^{-1}(x)) of a blocky S_M onto S, checked on real test surfaces and a staircase S_M built here.
 #include <meccano/error.hpp>
-#include <meccano/geometry.hpp>
-#include <meccano/parameterization.hpp>
+#include <meccano/geometry/geometry.hpp>
+#include <meccano/stages/parameterization.hpp>
 
 #include "test_surfaces.hpp"
 

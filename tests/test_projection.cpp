@@ -2,9 +2,9 @@
 // every S_M node lands on S, rim nodes on the rim of S, the mesh stays conforming; and the Hausdorff
 // distance between S and the projected S_M shrinks as l_r halves.
 
-#include <meccano/cube_meccano.hpp>
-#include <meccano/mesh_check.hpp>
-#include <meccano/pipeline.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/stages/pipeline.hpp>
 
 #include <test_surfaces.hpp>
 
@@ -105,7 +105,7 @@ TEST(Projection, HausdorffDistanceShrinksAsTheResolutionHalves) {
   }
 }
 
-// A roof folded by 2 atan(0.3) = 33 degrees along x = 0.5. Followed (creases.hpp), the fold is a path of
+// A roof folded by 2 atan(0.3) = 33 degrees along x = 0.5. Followed (surface/creases.hpp), the fold is a path of
 // S_M edges: its nodes stay on the ridge through smoothing, and every face lies on one of the two planes
 // but some within two cells of the rim (nodes joined to a rim node stay off the ridge). Not followed, faces across
 // the ridge are chords tilted by up to 16 degrees.

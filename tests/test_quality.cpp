@@ -2,10 +2,11 @@
 // its counterpart, Kuhn class values against the equilateral tet), inverted tets counted as 0, agreement
 // with a direct serial computation, independence of the thread count, and the histogram CSV.
 
-#include <meccano/bisection.hpp>
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/bisection.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/quality.hpp>
+#include <meccano/mesh/quality.hpp>
+#include <meccano/report/quality_csv.hpp>
 
 #include <gtest/gtest.h>
 #include <omp.h>

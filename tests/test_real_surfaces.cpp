@@ -10,12 +10,13 @@
 // held below the value measured on each case when this test was written, rounded up by a few degrees,
 // so that a change that brings back the chords across creases fails.
 
-#include <meccano/cube_meccano.hpp>
-#include <meccano/mesh_check.hpp>
-#include <meccano/mesh_io.hpp>
-#include <meccano/msh_measure.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/quality.hpp>
+#include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/io/mesh_writers.hpp>
+#include <meccano/inspect/mesh_file_measure.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/mesh/quality.hpp>
 
 #include <scratch_directory.hpp>
 #include <test_surfaces.hpp>
@@ -66,7 +67,7 @@ TEST_P(RealSurface, IsInsertedValidFaithfulAndAsEstimated) {
   const InsertionResult result =
       insert_surfaces(make_cube_meccano(testing::box_around(surface), 0), {&surface, 1}, options);
 
-  const MeshCheckReport check = verify_mesh(result.mesh);
+  const MeshInvariantReport check = verify_mesh(result.mesh);
   ASSERT_TRUE(check.ok()) << check.summary();
   const QualitySummary quality = summarize_quality(result.mesh);
   EXPECT_GE(quality.min_dihedral_deg, minimum_dihedral_deg) << "a sliver the improvement did not lift";

@@ -1,11 +1,11 @@
-// reference-gmsh (meshes/reference_gmsh.cpp): the Gmsh reference mesh, read back with the Gmsh library.
+// reference-gmsh (reference/reference_gmsh.cpp): the Gmsh reference mesh, read back with the Gmsh library.
 // Checked: orientation and volume of the tets, the interface is the input surface as given and made of
 // interior faces, the box sides tile the boundary, the report agrees with the mesh, the size field refines
 // near the surface, and the error paths.
 
-#include <meccano/geometry.hpp>
-#include <meccano/quality.hpp>
-#include <meccano/surface.hpp>
+#include <meccano/geometry/geometry.hpp>
+#include <meccano/mesh/quality.hpp>
+#include <meccano/io/surface_readers.hpp>
 
 #include <run_command.hpp>
 #include <scratch_directory.hpp>

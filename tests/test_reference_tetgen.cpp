@@ -1,15 +1,15 @@
-// reference-tetgen (meshes/reference_tetgen.cpp): the TetGen reference mesh, read back with meccano's own
+// reference-tetgen (reference/reference_tetgen.cpp): the TetGen reference mesh, read back with meccano's own
 // MSH reader (no libgmsh: it clashes with libtet) and checked with meccano's checker. Checked: the
 // module's checks pass (conformity, orientation, volume, box sides, every interface a disk), the groups
 // are exactly meccano-immerse's, every interface lies in its input surface (nodes on S, area of S, the
 // input triangles' orientation), the report agrees with the mesh, and the error paths.
 
-#include <meccano/geometry.hpp>
-#include <meccano/msh_check.hpp>
-#include <meccano/msh_reader.hpp>
-#include <meccano/quality.hpp>
-#include <meccano/surface.hpp>
-#include <meccano/tet_mesh.hpp>
+#include <meccano/geometry/geometry.hpp>
+#include <meccano/inspect/mesh_file_check.hpp>
+#include <meccano/io/msh_reader.hpp>
+#include <meccano/mesh/quality.hpp>
+#include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/tet_mesh.hpp>
 
 #include <run_command.hpp>
 #include <scratch_directory.hpp>

@@ -3,13 +3,14 @@
 // S_M's nodes on S and its rim on the rim of S, S_M still a disk embedded in P, the paper's quality, and
 // the same mesh whatever the thread count.
 
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh_check.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/quality.hpp>
-#include <meccano/smoothing.hpp>
-#include <meccano/surface.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/report/insertion_report.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/mesh/quality.hpp>
+#include <meccano/stages/smoothing.hpp>
+#include <meccano/io/surface_readers.hpp>
 
 #include <test_surfaces.hpp>
 

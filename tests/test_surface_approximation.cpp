@@ -3,11 +3,11 @@
 // configurations the healing rules remove, nodes close to S, oriented like S, the mesh conforming and
 // V_M still a ball.
 
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh_check.hpp>
-#include <meccano/surface.hpp>
-#include <meccano/surface_approximation.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/io/surface_readers.hpp>
+#include <meccano/stages/surface_approximation.hpp>
 
 #include <test_surfaces.hpp>
 

@@ -1,7 +1,7 @@
 // The geometric surface checks: every generated test surface is accepted; folds, surfaces outside or
 // on the boundary of the box, and crossing or touching pairs are rejected with a message that says so.
 #include <meccano/error.hpp>
-#include <meccano/surface_validation.hpp>
+#include <meccano/surface/validation.hpp>
 
 #include "test_surfaces.hpp"
 
@@ -70,7 +70,7 @@ TEST(GeometryChecks, SheetPassingThroughItselfIntersects) {
     const double t = -0.3 + p.x() * (std::numbers::pi + 0.6);
     p = Vector3d(0.5 + 0.3 * std::sin(t), 0.2 + 0.6 * p.y(), 0.5 + 0.3 * std::sin(t) * std::cos(t));
   }
-  EXPECT_NO_THROW(check_surface_topology(surface));
+  EXPECT_NO_THROW(require_surface_topology(surface));
   const std::string message = error_of([&] { validate_surfaces(std::vector{surface}, unit_box); });
   EXPECT_MESSAGE_HAS(message, "figure_eight: triangles ");
   EXPECT_MESSAGE_HAS(message, " intersect");
@@ -82,12 +82,12 @@ TEST(GeometryChecks, FoldedOverTrianglesIntersect) {
   TriangleSurface surface = testing::graph_patch([](double, double) { return 0.5; }, {0.2, 0.8}, {0.2, 0.8}, 4, "fold");
   const int centre = 2 * 5 + 2;
   surface.points[centre].x() += 0.15 * 1.5;
-  const std::string message = error_of([&] { check_no_self_intersection(surface); });
+  const std::string message = error_of([&] { require_no_self_intersection(surface); });
   EXPECT_MESSAGE_HAS(message, "fold: triangles ");
   EXPECT_MESSAGE_HAS(message, " intersect");
   // Dragged only part of the way, nothing folds.
   surface.points[centre].x() -= 0.15;
-  EXPECT_NO_THROW(check_no_self_intersection(surface));
+  EXPECT_NO_THROW(require_no_self_intersection(surface));
 }
 
 TEST(GeometryChecks, SelfIntersectionNamesTrianglesOneBased) {
@@ -97,14 +97,14 @@ TEST(GeometryChecks, SelfIntersectionNamesTrianglesOneBased) {
                  Vector3d(5, 5, 5), Vector3d(6, 5, 5), Vector3d(5, 6, 5),          // triangle 2, far away
                  Vector3d(0.2, 0.2, -1), Vector3d(0.2, 0.2, 1), Vector3d(2, 2, 0)};  // triangle 3 crosses 1
   soup.triangles = {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}};
-  EXPECT_EQ(error_of([&] { check_no_self_intersection(soup); }), "soup.obj: triangles 1 and 3 intersect");
+  EXPECT_EQ(error_of([&] { require_no_self_intersection(soup); }), "soup.obj: triangles 1 and 3 intersect");
 }
 
 TEST(GeometryChecks, SurfaceOutsideTheBox) {
   TriangleSurface surface = testing::paper_like_patch(6);
   surface.source = "bump.stl";
   surface.points[10].z() = 1.2;
-  const std::string message = error_of([&] { check_strictly_inside_box(surface, unit_box); });
+  const std::string message = error_of([&] { require_strictly_inside_box(surface, unit_box); });
   EXPECT_MESSAGE_HAS(message, "bump.stl: vertex 11 (");
   EXPECT_MESSAGE_HAS(message, "is outside the box [0, 1] x [0, 1] x [0, 1]");
   EXPECT_MESSAGE_HAS(error_of([&] { validate_surfaces(std::vector{surface}, unit_box); }), "outside the box");
@@ -113,18 +113,18 @@ TEST(GeometryChecks, SurfaceOutsideTheBox) {
 TEST(GeometryChecks, VertexOnTheBoxBoundary) {
   TriangleSurface surface = testing::tilted_plane(4);  // vertex 1 is the rim corner (0.1, 0.1, z)
   surface.points[0].x() = 0.0;
-  std::string message = error_of([&] { check_strictly_inside_box(surface, unit_box); });
+  std::string message = error_of([&] { require_strictly_inside_box(surface, unit_box); });
   EXPECT_MESSAGE_HAS(message, "tilted_plane: vertex 1 (0, 0.1, ");
   EXPECT_MESSAGE_HAS(message, "lies on the box boundary");
   // Within the margin (1e-9 of the diagonal) of the boundary counts as on it, beyond as inside/outside.
   surface.points[0].x() = 1e-12;
-  EXPECT_MESSAGE_HAS(error_of([&] { check_strictly_inside_box(surface, unit_box); }), "lies on the box boundary");
+  EXPECT_MESSAGE_HAS(error_of([&] { require_strictly_inside_box(surface, unit_box); }), "lies on the box boundary");
   surface.points[0].x() = -1e-12;
-  EXPECT_MESSAGE_HAS(error_of([&] { check_strictly_inside_box(surface, unit_box); }), "lies on the box boundary");
+  EXPECT_MESSAGE_HAS(error_of([&] { require_strictly_inside_box(surface, unit_box); }), "lies on the box boundary");
   surface.points[0].x() = -1e-6;
-  EXPECT_MESSAGE_HAS(error_of([&] { check_strictly_inside_box(surface, unit_box); }), "is outside the box");
+  EXPECT_MESSAGE_HAS(error_of([&] { require_strictly_inside_box(surface, unit_box); }), "is outside the box");
   surface.points[0].x() = 1e-6;
-  EXPECT_NO_THROW(check_strictly_inside_box(surface, unit_box));
+  EXPECT_NO_THROW(require_strictly_inside_box(surface, unit_box));
 }
 
 TEST(GeometryChecks, CrossingSurfacesIntersect) {
@@ -136,7 +136,7 @@ TEST(GeometryChecks, CrossingSurfacesIntersect) {
   EXPECT_MESSAGE_HAS(message, " of paper_like, triangle ");
   // Crossing at right angles.
   const TriangleSurface wall = testing::near_vertical_patch(5);
-  EXPECT_MESSAGE_HAS(error_of([&] { check_surfaces_disjoint(wall, plane); }), "near_vertical and plane.off intersect");
+  EXPECT_MESSAGE_HAS(error_of([&] { require_surfaces_disjoint(wall, plane); }), "near_vertical and plane.off intersect");
 }
 
 TEST(GeometryChecks, TouchingSurfacesTouch) {
@@ -149,11 +149,11 @@ TEST(GeometryChecks, TouchingSurfacesTouch) {
   // A wall standing on the floor: its bottom edge lies in the floor (exact contact, no crossing).
   TriangleSurface wall = testing::graph_patch([](double, double) { return 0.0; }, {0, 1}, {0, 1}, 4, "wall");
   for (Vector3d& p : wall.points) p = Vector3d(0.45, 0.3 + 0.3 * p.x(), 0.5 + 0.3 * p.y());
-  message = error_of([&] { check_surfaces_disjoint(floor, wall); });
+  message = error_of([&] { require_surfaces_disjoint(floor, wall); });
   EXPECT_MESSAGE_HAS(message, "floor and wall touch");
   // Lifted by 1e-6 they are apart.
   for (Vector3d& p : wall.points) p.z() += 1e-6;
-  EXPECT_NO_THROW(check_surfaces_disjoint(floor, wall));
+  EXPECT_NO_THROW(require_surfaces_disjoint(floor, wall));
   EXPECT_NO_THROW(validate_surfaces(std::vector{floor, wall}, unit_box));
 }
 

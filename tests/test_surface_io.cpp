@@ -1,6 +1,6 @@
 // Surface readers: round trips through every supported format, every error path, welding and parts.
 #include <meccano/error.hpp>
-#include <meccano/surface.hpp>
+#include <meccano/io/surface_readers.hpp>
 
 #include <Eigen/Geometry>
 #include <gmock/gmock.h>

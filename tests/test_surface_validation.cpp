@@ -1,6 +1,6 @@
-// check_surface_topology: valid disks pass, and each defect is reported with its element.
+// require_surface_topology: valid disks pass, and each defect is reported with its element.
 #include <meccano/error.hpp>
-#include <meccano/surface_validation.hpp>
+#include <meccano/surface/validation.hpp>
 
 #include <Eigen/Geometry>
 #include <gmock/gmock.h>
@@ -100,7 +100,7 @@ TriangleSurface punctured_torus() {
 // The InputError's message; any other outcome fails the test.
 std::string topology_error(const TriangleSurface& surface) {
   try {
-    meccano::check_surface_topology(surface);
+    meccano::require_surface_topology(surface);
   } catch (const InputError& error) {
     return error.what();
   }
@@ -109,16 +109,16 @@ std::string topology_error(const TriangleSurface& surface) {
 }
 
 TEST(SurfaceTopology, ValidDisksPass) {
-  EXPECT_NO_THROW(meccano::check_surface_topology(grid_patch()));
-  EXPECT_NO_THROW(meccano::check_surface_topology(grid_patch(1)));
-  EXPECT_NO_THROW(meccano::check_surface_topology(fan(6)));
-  EXPECT_NO_THROW(meccano::check_surface_topology(make_surface({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{{0, 1, 2}}})));
+  EXPECT_NO_THROW(meccano::require_surface_topology(grid_patch()));
+  EXPECT_NO_THROW(meccano::require_surface_topology(grid_patch(1)));
+  EXPECT_NO_THROW(meccano::require_surface_topology(fan(6)));
+  EXPECT_NO_THROW(meccano::require_surface_topology(make_surface({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{{0, 1, 2}}})));
 }
 
 TEST(SurfaceTopology, UnusedVerticesAreAllowed) {
   TriangleSurface surface = grid_patch();
   surface.points.emplace_back(9, 9, 9);
-  EXPECT_NO_THROW(meccano::check_surface_topology(surface));
+  EXPECT_NO_THROW(meccano::require_surface_topology(surface));
 }
 
 TEST(SurfaceTopology, NoTriangles) {

@@ -4,8 +4,8 @@
 // reference-tetgen write (MSH 4.1), each group holding elements, and the module's formats agreeing on how
 // many.
 
-#include <meccano/msh_reader.hpp>
-#include <meccano/tet_mesh.hpp>
+#include <meccano/io/msh_reader.hpp>
+#include <meccano/mesh/tet_mesh.hpp>
 
 #include <run_command.hpp>
 #include <scratch_directory.hpp>

@@ -2,11 +2,11 @@
 // V_M contains S, is a topological ball with axis-parallel boundary faces, every tet meeting S is
 // shorter than l_r, and the mesh stays conforming. Regions of earlier surfaces follow refinement.
 
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh_check.hpp>
-#include <meccano/surface.hpp>
-#include <meccano/volumetric_approximation.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/io/surface_readers.hpp>
+#include <meccano/stages/volumetric_approximation.hpp>
 
 #include <test_surfaces.hpp>
 

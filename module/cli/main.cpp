@@ -1,16 +1,18 @@
 // meccano-immerse: the command-line front end of the module.
 // Exit status: 0 success, 1 failure (bad input data, meshing failed, cannot write), 2 usage error.
 
-#include <meccano/atomic_file.hpp>
-#include <meccano/cube_meccano.hpp>
+#include <meccano/io/atomic_file.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh_check.hpp>
-#include <meccano/mesh_io.hpp>
-#include <meccano/msh_check.hpp>
-#include <meccano/msh_measure.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/surface.hpp>
-#include <meccano/surface_validation.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/io/mesh_writers.hpp>
+#include <meccano/inspect/mesh_file_check.hpp>
+#include <meccano/inspect/mesh_file_measure.hpp>
+#include <meccano/report/insertion_report.hpp>
+#include <meccano/report/quality_csv.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/io/surface_readers.hpp>
+#include <meccano/surface/validation.hpp>
 
 #include "tool_support.hpp"
 
@@ -420,9 +422,9 @@ std::vector<meccano::TriangleSurface> read_surfaces(const Options& options, cons
 
 int run(const Options& options) {
   // Every file the run writes, checked before any work: a mistyped path must not cost a meshing run.
-  for (const auto& output : options.outputs) meccano::check_writable(output.path);
+  for (const auto& output : options.outputs) meccano::require_writable(output.path);
   for (const auto& path : {options.histograms, options.report})
-    if (path) meccano::check_writable(*path);
+    if (path) meccano::require_writable(*path);
   const Progress progress(options.quiet);
   if (options.threads) omp_set_num_threads(*options.threads);
   const auto cells = options.cells ? *options.cells : meccano::cells_for_box(options.box);
@@ -431,7 +433,7 @@ int run(const Options& options) {
   const std::int64_t expected_tets = tets < 0x1p62 ? static_cast<std::int64_t>(tets) : std::int64_t{1} << 62;
   progress.say("meccano: ", cells[0], "x", cells[1], "x", cells[2], " cells, level ", options.level, ", ",
                expected_tets, " tets");
-  meccano::check_tet_estimate(expected_tets, options.max_tets, "the meccano mesh (--cells, --level)");
+  meccano::require_tet_estimate_within(expected_tets, options.max_tets, "the meccano mesh (--cells, --level)");
   // Read and validate every surface before any meshing: bad input must not cost a meshing run.
   std::vector<meccano::TriangleSurface> surfaces = read_surfaces(options, progress);
   meccano::validate_surfaces(surfaces, options.box);
@@ -518,7 +520,7 @@ FileCommand parse_file_command(const std::string& command, const std::vector<std
     }
   }
   if (parsed.file.empty()) throw UsageError(command + " needs a mesh file: meccano-immerse " + command + " FILE.msh");
-  if (parsed.report) meccano::check_writable(*parsed.report);  // before the mesh file is read
+  if (parsed.report) meccano::require_writable(*parsed.report);  // before the mesh file is read
   return parsed;
 }
 

@@ -3,7 +3,7 @@
 // not part of the installed library.
 #pragma once
 
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 
 #include <array>
 #include <cctype>

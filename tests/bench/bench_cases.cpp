@@ -8,8 +8,8 @@
 //
 // Usage: bench_cases [--grid N]   (surfaces on an N x N grid, default 16, as in the tests)
 
-#include <meccano/cube_meccano.hpp>
-#include <meccano/pipeline.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/stages/pipeline.hpp>
 
 #include <test_surfaces.hpp>
 

@@ -23,7 +23,7 @@
 # Usage: tests/bench/bench_faults.sh [--quick] [--build DIR] [--threads N] [--work DIR] [--cases A,B,...]
 #                                    [--write]
 #   --quick      E/30 and E/50 on three cases (shell_beds, creased, vertical), a smoke run of a few minutes
-#   --build DIR  the build directory with module/meccano-immerse and meshes/reference-gmsh (default: build)
+#   --build DIR  the build directory with module/meccano-immerse and reference/reference-gmsh (default: build)
 #   --threads N  threads for meccano-immerse and Gmsh (default: all cores)
 #   --work DIR   keep the runs' reports and the split surfaces in DIR (default: a temporary directory,
 #                removed at the end); `bench_faults.py report DIR [doc/benchmarks.md]` re-renders them
@@ -53,7 +53,7 @@ while [ $# -gt 0 ]; do
 done
 
 cli=$build/module/meccano-immerse
-gmsh_tool=$build/meshes/reference-gmsh
+gmsh_tool=$build/reference/reference-gmsh
 for tool in "$cli" "$gmsh_tool"; do
   [ -x "$tool" ] || { echo "bench_faults: $tool is missing: build it first" >&2; exit 1; }
 done

@@ -8,7 +8,7 @@
 // Usage: bench_parameterization [--largest N] [--queries Q]
 //        (default: surfaces up to 1e6 triangles, 1e6 queries of each kind)
 
-#include <meccano/parameterization.hpp>
+#include <meccano/stages/parameterization.hpp>
 
 #include <test_surfaces.hpp>
 

@@ -11,10 +11,10 @@
 //
 // Usage: bench_projection [--finest K]   (l_r down to 1/2^K, default K = 9; K = 8 stops near 3e5)
 
-#include <meccano/cube_meccano.hpp>
-#include <meccano/projection.hpp>
-#include <meccano/surface_approximation.hpp>
-#include <meccano/volumetric_approximation.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/stages/projection.hpp>
+#include <meccano/stages/surface_approximation.hpp>
+#include <meccano/stages/volumetric_approximation.hpp>
 
 #include <test_surfaces.hpp>
 

@@ -5,8 +5,8 @@
 //
 // Usage: bench_refinement [--max-level K] [--repeat N]
 
-#include <meccano/bisection.hpp>
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/bisection.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 
 #include <algorithm>
 #include <chrono>

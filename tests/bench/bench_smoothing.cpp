@@ -11,9 +11,10 @@
 //        (l_r down to 1/2^K, default K = 8; best of N runs, default 1; FILE defaults to
 //        meshes/cube_example.obj, relative to the repository root where tests/bench/run.sh runs)
 
-#include <meccano/cube_meccano.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/surface_validation.hpp>
+#include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/surface/validation.hpp>
 
 #include <cstdio>
 #include <cstdlib>

@@ -19,7 +19,7 @@ if [ "${1:-}" = "--threads" ]; then threads=$2; shift 2; fi
 [ $# -gt 0 ] && resolutions=("$@") || resolutions=(0.03125 0.015625 0.0078125)
 sizes=(0.05 0.035 0.025 0.018 0.0125)
 cli=build/module/meccano-immerse
-gmsh_tool=build/meshes/reference-gmsh
+gmsh_tool=build/reference/reference-gmsh
 [ -x "$cli" ] && [ -x "$gmsh_tool" ] || { echo "compare_gmsh: build first (scripts/build.sh; reference-gmsh needs libgmsh-dev)" >&2; exit 1; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

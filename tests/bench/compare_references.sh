@@ -49,8 +49,8 @@ while [ $# -gt 0 ]; do
 done
 
 cli=$build/module/meccano-immerse
-gmsh_tool=$build/meshes/reference-gmsh
-tetgen_tool=$build/meshes/reference-tetgen
+gmsh_tool=$build/reference/reference-gmsh
+tetgen_tool=$build/reference/reference-tetgen
 solver=$build/solver_demo/poisson_interface
 for tool in "$cli" "$gmsh_tool" "$tetgen_tool" "$solver"; do
   [ -x "$tool" ] || { echo "compare_references: $tool is missing: build it first" >&2; exit 1; }

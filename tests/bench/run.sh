@@ -18,8 +18,8 @@ done
 echo
 echo "## bench_faults.sh --quick"
 echo
-if [ -x build/meshes/reference-gmsh ]; then
+if [ -x build/reference/reference-gmsh ]; then
   tests/bench/bench_faults.sh --quick
 else
-  echo "Skipped: build/meshes/reference-gmsh was not built (no Gmsh library found)."
+  echo "Skipped: build/reference/reference-gmsh was not built (no Gmsh library found)."
 fi

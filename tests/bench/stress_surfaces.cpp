@@ -13,15 +13,15 @@
 // Usage: stress_surfaces [--seed S] [--cases K] [--first I] [--threads T] [--dump DIR]
 // Case i depends only on (S, i): `--first i --cases 1` reruns it alone; --dump writes each case's surfaces
 // to DIR/case<i>_<name>.obj with the meccano-immerse command that inserts them, to reproduce it there.
-#include <meccano/atomic_file.hpp>
-#include <meccano/box.hpp>
-#include <meccano/cube_meccano.hpp>
+#include <meccano/io/atomic_file.hpp>
+#include <meccano/mesh/box.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/geometry.hpp>
-#include <meccano/mesh_check.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/surface_approximation.hpp>
-#include <meccano/surface_validation.hpp>
+#include <meccano/geometry/geometry.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/stages/surface_approximation.hpp>
+#include <meccano/surface/validation.hpp>
 
 #include <Eigen/Geometry>
 
@@ -185,7 +185,7 @@ std::string reason_of(const std::string& message) {
 // Empty when the result meets every invariant; otherwise what is wrong.
 std::string defects_of(const meccano::InsertionResult& result, const std::vector<TriangleSurface>& surfaces) {
   std::ostringstream out;
-  const meccano::MeshCheckReport check = meccano::verify_mesh(result.mesh);
+  const meccano::MeshInvariantReport check = meccano::verify_mesh(result.mesh);
   if (!check.ok()) out << "verify_mesh: " << check.summary() << "; ";
   if (check.inverted_physical != 0) out << check.inverted_physical << " inverted tets; ";
   const double tolerance = 1e-9 * std::sqrt(3.0);  // the unit cube's diagonal

@@ -4,10 +4,10 @@
 // It inserts a small curved patch into the unit-cube meccano at l_r = 0.125 and checks the result:
 // no inverted tet, verify_mesh finds no problem, and the patch is present as interface faces.
 // Output  one line per check; exit status 0 if all pass, 1 otherwise (or on any exception).
-#include <meccano/cube_meccano.hpp>
-#include <meccano/mesh_check.hpp>
-#include <meccano/pipeline.hpp>
-#include <meccano/surface_validation.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/surface/validation.hpp>
 
 #include <cmath>
 #include <exception>
@@ -60,7 +60,7 @@ int main() {
         meccano::insert_surfaces(meccano::make_cube_meccano(unit_cube), surfaces, options);
     std::cout << result.mesh.num_tets() << " tets, " << result.mesh.num_vertices() << " vertices\n";
 
-    const meccano::MeshCheckReport check = meccano::verify_mesh(result.mesh);
+    const meccano::MeshInvariantReport check = meccano::verify_mesh(result.mesh);
     std::size_t interface_faces = 0;
     for (const meccano::FaceGroup& group : meccano::output_groups(result).surfaces)
       if (group.name == "interface_patch") interface_faces = group.faces.size();

@@ -14,7 +14,7 @@
 // It prints the sizes, the area of S and the outflow, and exits 1 if S's faces do not add up to S's
 // triangles or the outflow is off by more than 25 % (the far field of these small meshes is coarse).
 
-#include <meccano/cube_meccano.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/dealii_mesh.hpp>
 
 #include <deal.II/base/quadrature_lib.h>

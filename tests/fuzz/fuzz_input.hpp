@@ -10,7 +10,7 @@
 #pragma once
 
 #include <meccano/error.hpp>
-#include <meccano/surface.hpp>
+#include <meccano/io/surface_readers.hpp>
 
 #include <cstddef>
 #include <cstdint>

@@ -8,7 +8,7 @@
 // i - 4, so a few negative and out-of-range indices occur. validate_surfaces must either accept the set
 // or throw InputError; anything else (another exception, a sanitizer report, a hang) is a finding.
 #include <meccano/error.hpp>
-#include <meccano/surface_validation.hpp>
+#include <meccano/surface/validation.hpp>
 
 #include <array>
 #include <cstddef>

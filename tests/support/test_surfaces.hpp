@@ -6,8 +6,8 @@
 // rings of the spherical cap; triangle counts grow like n^2.
 #pragma once
 
-#include <meccano/box.hpp>
-#include <meccano/surface.hpp>
+#include <meccano/mesh/box.hpp>
+#include <meccano/surface/triangle_surface.hpp>
 
 #include <array>
 #include <cstdint>

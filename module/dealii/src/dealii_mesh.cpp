@@ -1,7 +1,7 @@
 #include <meccano/dealii_mesh.hpp>
 
 #include <meccano/error.hpp>
-#include <meccano/msh_reader.hpp>
+#include <meccano/io/msh_reader.hpp>
 
 #include <deal.II/distributed/tria_base.h>
 #include <deal.II/grid/grid_tools.h>

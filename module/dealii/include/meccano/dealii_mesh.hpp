@@ -24,7 +24,7 @@
 // deal.II 9.4 degrades tets under refine_global: refine with meccano-immerse (a smaller --resolution).
 #pragma once
 
-#include <meccano/pipeline.hpp>
+#include <meccano/stages/pipeline.hpp>
 
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/point.h>

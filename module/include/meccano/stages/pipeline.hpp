@@ -1,0 +1,142 @@
+// The whole insertion, read top-down like the paper's four steps.
+//
+// Input    a meccano mesh (mesh/cube_meccano.hpp), surfaces that passed validate_surfaces, and options.
+// Steps    1. volumetric approximation V_M of each surface (stages/volumetric_approximation.hpp);
+//          2. surface approximation S_M of each surface, healed (stages/surface_approximation.hpp); once all
+//             are built, any S_M that a later surface's refinement disturbed is healed again;
+//          3. projection of each S_M onto its surface (stages/projection.hpp);
+//          4. simultaneous untangling and smoothing of the whole mesh or of a band around the surfaces
+//             (stages/smoothing.hpp). If tets stay inverted, the insertion is run again with the S_M of the
+//             surfaces next to them on the other side of S (when the side rule allows it); a mesh that
+//             stays tangled is an error, never a result.
+//          Then the worst tets are lifted (stages/improvement.hpp) unless options.improve is none; the quality
+//          after smoothing is that of the result, after the improvement.
+//          A surface whose insertion still fails (V_M cannot be grown within reach of S, S_M cannot be
+//          healed, or the tets next to its S_M stay tangled on both sides) is inserted again, from the
+//          input mesh, at a finer l_r, at most options.finer_retries times, together with the surfaces
+//          whose S_M could touch its own: half its l_r, or finer where the gap to those surfaces or to
+//          the box leaves no room for S_M at half (the gap decides the first finer l_r, instead of
+//          halving attempt after attempt). l_r is an upper bound on the edges near S, so a finer one
+//          still honours it. result.finer_retries says why.
+//          The surfaces are taken one after the other; a later surface's refinement keeps the earlier
+//          surfaces' regions in step (bisection does not change a region's point set).
+// Output   the refined mesh, each surface's V_M, per-stage statistics and timings; surface_interfaces()
+//          lists each surface's faces with the tets on both sides, output_groups() the named groups the
+//          file writers take.
+// Progress a callback receives one line per stage with counts, and one per smoothing sweep.
+// Refusal before any refinement: l_r <= 0 (with surfaces), or an estimated tet count (estimate_tets) above
+//          options.max_tets, are InputErrors: an absurdly small l_r fails at once instead of exhausting memory.
+#pragma once
+
+#include <meccano/stages/improvement.hpp>
+#include <meccano/io/mesh_writers.hpp>
+#include <meccano/stages/projection.hpp>
+#include <meccano/mesh/quality.hpp>
+#include <meccano/stages/smoothing.hpp>
+#include <meccano/surface/triangle_surface.hpp>
+#include <meccano/stages/surface_approximation.hpp>
+#include <meccano/mesh/tet_mesh.hpp>
+#include <meccano/stages/volumetric_approximation.hpp>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace meccano {
+
+enum class Stage { volumetric, approximation, projection, smoothing };
+enum class Improvement { none, smooth, topology };
+
+// Memory per tet while the pipeline runs: the mesh's 53-80 bytes (doc/design.md) plus the stages' working
+// arrays, about 200; the default limit keeps a run below 16 GiB.
+inline constexpr std::int64_t estimated_bytes_per_tet = 280;
+inline constexpr std::int64_t default_max_tets = (std::int64_t{16} << 30) / estimated_bytes_per_tet;
+
+// The tet count of an insertion, estimated before any refinement: the meccano's tets plus, per surface,
+// the cubes of V_M's level (level_for_resolution) that S crosses, from its area and normals, times the
+// tets per such cube of the finished mesh (V_M, the conforming closure around it, healing), fitted per
+// level type on real faults and test surfaces (doc/benchmarks.md, "Predictable cost").
+std::int64_t estimate_tets(const MeccanoGrid& meccano, std::int64_t meccano_tets,
+                           std::span<const TriangleSurface> surfaces, double resolution);
+
+// Throws InputError if `estimated_tets` exceeds `max_tets`, naming `what` (the cause) and the memory it
+// would take.
+void require_tet_estimate_within(std::int64_t estimated_tets, std::int64_t max_tets, const std::string& what);
+
+struct InsertionOptions {
+  double resolution = 0.0;  // l_r, a length in physical units
+  Stage last_stage = Stage::smoothing;
+  SurfaceApproximationOptions approximation;  // side rule, healing pass limit
+  ProjectionOptions projection;               // Floater weights, creases followed
+  SmoothingOptions smoothing;                 // SUS mode, target and limits
+  // After SUS: lift the worst tets by smoothing and flips (topology), by smoothing alone (smooth: keeps
+  // every tet in the bisection hierarchy, for callers that refine the result further), or not at all.
+  Improvement improve = Improvement::topology;
+  ImprovementOptions improvement;            // its `topology` is set from `improve`
+  int threads = 0;                            // OpenMP threads for this call; 0 = OpenMP's default
+  std::int64_t max_tets = default_max_tets;    // refuse when estimate_tets exceeds it
+  int finer_retries = 2;                      // times a failing surface may be retried at a finer l_r
+  std::function<void(const std::string&)> progress;  // one line per stage and per smoothing sweep, with counts
+};
+
+struct SurfaceInsertion {
+  std::string name;
+  double resolution = 0.0;  // the l_r it was inserted at: options.resolution, or less after finer retries
+  TetRegion volumetric;  // V_M, one flag per tet of the final mesh
+  VolumetricStats volumetric_stats;
+  double volumetric_seconds = 0.0;
+  HealingStats healing_stats;  // of the last healing of this surface's S_M
+  double approximation_seconds = 0.0;
+  SurfaceProjection projection;
+  double projection_seconds = 0.0;
+};
+
+struct InsertionResult {
+  TetMesh mesh;
+  std::vector<SurfaceInsertion> surfaces;
+  SmoothingStats smoothing;
+  double smoothing_seconds = 0.0;
+  QualitySummary quality_before_smoothing;  // right after projection (tets may be inverted)
+  std::optional<ImprovementStats> improvement;  // when the improvement ran
+  double improvement_seconds = 0.0;
+  QualitySummary quality_after_smoothing;   // of the result: after SUS and the improvement
+  double seconds = 0.0;                     // the whole insertion
+  std::int64_t estimated_tets = 0;          // estimate_tets before any refinement, for the l_r asked
+  std::string side_retry;  // why the insertion was run again with S_M on the other side (empty if not)
+  std::vector<std::string> finer_retries;  // why it was run again with finer l_r for some surfaces, in order
+};
+
+InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options);
+
+// `domain`, the box sides, and `interface_NAME` for every surface's S_M (once built), oriented like the
+// surface; at the inspection stages (last_stage before smoothing) also `volumetric_NAME` for every
+// surface's V_M. Tags as in io/mesh_writers.hpp: surface k's interface is 7 + k whichever S_M exist, its V_M
+// 2 + k. The final mesh leaves V_M out: formats that write an element once per group (MSH 2.2,
+// VTU) would otherwise hold its tets twice.
+MeshGroups output_groups(const InsertionResult& result, Stage last_stage = Stage::smoothing);
+
+// What a solver needs to impose a condition on an inserted surface: each face of S_M once, with the
+// tets on both sides. The vertex order and `normal` agree with the surface's normals (right-hand rule);
+// the normal points out of `negative` (the tet on S's negative side) into `positive`. Box-side faces
+// carry box_side_tag in mesh.face_tags; every tet belongs to the one volume, `domain`.
+struct InterfaceFace {
+  std::array<VertexId, 3> vertices;
+  Eigen::Vector3d normal;  // unit
+  FaceRef negative;        // the tet behind the face and its local face
+  FaceRef positive;        // the tet in front of it
+};
+
+struct SurfaceInterface {
+  std::string name;
+  FaceTag tag;  // interface_tag(index) in mesh.face_tags
+  std::vector<InterfaceFace> faces;
+};
+
+// One entry per surface whose S_M was built (every surface once the approximation stage has run).
+std::vector<SurfaceInterface> surface_interfaces(const InsertionResult& result);
+
+}  // namespace meccano

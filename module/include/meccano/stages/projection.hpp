@@ -1,0 +1,67 @@
+// Step 3 of the method (paper §4.3): every node of S_M moves onto S, x_i = φ(φ_M^{-1}(x_Mi)).
+//
+// Input    the mesh, the index and side of a healed S_M (stages/surface_approximation.hpp), and S.
+// Steps    1. S and S_M (its faces oriented like S) are parameterized onto P = [0,1]^2 with Floater's
+//             weights (stages/parameterization.hpp); S_M's weights are taken with its nodes pulled 80 % of the
+//             way onto S, so that the two parameterizations nearly agree (see stages/projection.cpp). S's corners are chosen along its rim by arc length (natural
+//             corners kept); S_M's are the rim nodes closest to them, in the same cyclic order around the
+//             same mean normal, so φ ∘ φ_M^{-1} does not twist.
+//          2. S_M follows the creases of S sharper than options.crease_angle (surface/creases.hpp): nodes near a
+//             crease move, in P, onto it, forming paths of S_M edges along the crease lines.
+//          3. Each S_M node's parameters u (φ_M^{-1}(x_M), or its place on a crease) are located in S's
+//             parametric triangulation and the node moves to φ(u). Rim nodes land on the rim of S,
+//             corners on its corners, crease nodes on the crease edges of S.
+// Output   the moved mesh (tets may be tangled: step 4 untangles them), the parameterizations, and
+//          statistics: how far nodes moved, how far they are from S afterwards, inverted tets.
+// Errors   MeshingError from the parameterization (rim not one loop, corners impossible, map not
+//          one-to-one).
+#pragma once
+
+#include <meccano/surface/creases.hpp>
+#include <meccano/geometry/geometry.hpp>
+#include <meccano/stages/parameterization.hpp>
+#include <meccano/surface/triangle_surface.hpp>
+#include <meccano/mesh/tet_mesh.hpp>
+#include <meccano/stages/volumetric_approximation.hpp>
+
+#include <array>
+#include <memory>
+
+namespace meccano {
+
+struct ProjectionStats {
+  std::int64_t nodes = 0;              // S_M nodes moved
+  std::int64_t rim_nodes = 0;
+  double largest_move = 0.0;           // physical distance, x_i - x_Mi
+  double largest_distance_after = 0.0; // of a moved node to S (round-off)
+  std::int64_t inverted_tets = 0;      // after the move, before smoothing
+  CreaseStats creases;
+};
+
+struct ProjectionOptions {
+  FloaterWeights weights = FloaterWeights::mean_value;
+  double crease_angle = default_crease_angle;  // degrees; creases of S sharper than this are followed (180: none)
+};
+
+// What step 4 needs to move S_M nodes within S: φ, and each S_M node's parameters.
+struct SurfaceProjection {
+  std::unique_ptr<ParametricSurface> surface;  // φ: P -> S
+  std::vector<VertexId> nodes;                 // the S_M nodes
+  std::vector<Eigen::Vector2d> uv;             // their parameters (same order)
+  std::vector<std::uint8_t> on_rim;            // same order
+  std::vector<std::array<int, 3>> triangles;   // S_M's triangles as indices into `nodes`, oriented like S
+  int orientation = 1;                         // the sign of their areas in P (uv), which step 4 keeps
+  CreaseNodes creases;                         // which nodes lie on a crease line of S, and where
+  ProjectionStats stats;
+};
+
+// Whether S_M's triangle (indices of `projection.nodes`) keeps S_M's orientation in P with its node `moved`
+// at `uv` (the others at their parameters): what steps 3-4 and the improvement keep for every triangle.
+bool keeps_orientation(const SurfaceProjection& projection, const std::array<int, 3>& triangle, int moved,
+                       const Eigen::Vector2d& uv);
+
+SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,
+                                       const TriangleSurface& surface, const TriangleBVH& tree,
+                                       const ProjectionOptions& options = {});
+
+}  // namespace meccano

@@ -1,0 +1,1324 @@
+// Surface readers (OBJ, STL, OFF, Gmsh MSH, GOCAD TSurf), vertex welding and the parts of a surface.
+//
+// Every reader loads the whole file, parses it with FileCursor (text tokens with line numbers, or
+// binary values), and hands the raw points and triangles to finish_surface, which welds the
+// duplicated vertices, drops the triangles a deliberate weld collapsed, and drops the unused
+// vertices. Header counts are checked against the bytes left in the file before anything is
+// allocated from them, so a corrupt count yields an error instead of a bad_alloc.
+#include <meccano/error.hpp>
+#include <meccano/io/surface_readers.hpp>
+
+#include "mesh/topology_helpers.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string_view>
+#include <unordered_map>
+#include <utility>
+
+namespace meccano {
+namespace {
+
+using Triangle = std::array<int, 3>;
+
+[[noreturn]] void fail_file(const std::string& path, const std::string& defect) {
+  throw InputError(path + ": " + defect);
+}
+
+// A token for an error message: file contents may be binary garbage or a megabyte without spaces.
+std::string quoted(std::string_view text, std::size_t max_shown = 40) {
+  std::string shown;
+  for (const char ch : text.substr(0, max_shown)) {
+    const auto code = static_cast<unsigned char>(ch);
+    shown += (code < 0x20 || code == 0x7f) ? '?' : ch;
+  }
+  if (text.size() > max_shown) shown += "...";
+  return "'" + shown + "'";
+}
+
+bool iequals(std::string_view a, std::string_view b) {
+  return std::ranges::equal(a, b, [](char x, char y) {
+    return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+  });
+}
+
+std::string read_file_bytes(const std::string& path) {
+  std::error_code ignored;
+  if (std::filesystem::is_directory(path, ignored)) fail_file(path, "cannot open file (it is a directory)");
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) fail_file(path, "cannot open file");
+  const std::streamoff size = in.tellg();
+  if (size < 0) fail_file(path, "cannot read file");
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  in.seekg(0);
+  if (!in.read(bytes.data(), size)) fail_file(path, "cannot read file");
+  if (bytes.empty()) fail_file(path, "empty file");
+  return bytes;
+}
+
+struct Token {
+  std::string_view text;
+  int line = 0;
+};
+
+// A read position in a file's bytes, shared by all readers: whitespace-separated text tokens (with
+// line numbers and optional comments running to the end of the line) and native or little-endian
+// binary values. Errors name the file and, until binary data has been read, the line.
+class FileCursor {
+ public:
+  FileCursor(std::string path, std::string_view bytes, char comment = '\0')
+      : path_(std::move(path)), bytes_(bytes), comment_(comment) {}
+
+  const std::string& path() const { return path_; }
+  std::size_t remaining() const { return bytes_.size() - pos_; }
+
+  std::optional<Token> next_token() {
+    skip_blanks(/*cross_lines=*/true);
+    return token_here();
+  }
+  // No token when the current line has none left.
+  std::optional<Token> next_token_on_line() {
+    skip_blanks(/*cross_lines=*/false);
+    return token_here();
+  }
+  Token expect_token(std::string_view what) {
+    if (auto token = next_token()) return *token;
+    fail_at_end(what);
+  }
+  Token expect_token_on_line(std::string_view what) {
+    if (auto token = next_token_on_line()) return *token;
+    if (pos_ == bytes_.size()) fail_at_end(what);
+    fail("expected " + std::string(what) + " before the end of the line");
+  }
+  Token expect_keyword(std::string_view keyword) {
+    const Token token = expect_token("'" + std::string(keyword) + "'");
+    if (!iequals(token.text, keyword))
+      fail_at(token.line, "expected '" + std::string(keyword) + "', found " + quoted(token.text));
+    return token;
+  }
+  void skip_line() { rest_of_line(); }
+  // The raw rest of the current line (comments included), moving to the start of the next one.
+  std::string_view rest_of_line() {
+    const std::size_t end = bytes_.find('\n', pos_);
+    const std::string_view rest = bytes_.substr(pos_, end == std::string_view::npos ? end : end - pos_);
+    pos_ = end == std::string_view::npos ? bytes_.size() : end + 1;
+    if (end != std::string_view::npos) ++line_;
+    return rest;
+  }
+  // Moves just past the next occurrence of `marker`; false (and no move) when there is none.
+  bool skip_past(std::string_view marker) { return text_until(marker).has_value(); }
+  // The raw text up to the next occurrence of `marker`, moving just past it; none (and no move) when
+  // there is none.
+  std::optional<std::string_view> text_until(std::string_view marker) {
+    const std::size_t found = bytes_.find(marker, pos_);
+    if (found == std::string_view::npos) return std::nullopt;
+    const std::string_view text = bytes_.substr(pos_, found - pos_);
+    const std::size_t end = found + marker.size();
+    line_ += static_cast<int>(std::ranges::count(bytes_.substr(pos_, end - pos_), '\n'));
+    pos_ = end;
+    return text;
+  }
+
+  long long integer(const Token& token, std::string_view what) const {
+    const std::string_view text = without_plus(token.text);
+    long long value = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error == std::errc::invalid_argument || end != text.data() + text.size())
+      fail_at(token.line, "malformed " + std::string(what) + " " + quoted(token.text));
+    if (error == std::errc::result_out_of_range)
+      fail_at(token.line, std::string(what) + " " + quoted(token.text) + " is out of range");
+    return value;
+  }
+  double number(const Token& token, std::string_view what) const {
+    const std::string_view text = without_plus(token.text);
+    double value = 0;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error == std::errc::invalid_argument || end != text.data() + text.size())
+      fail_at(token.line, "malformed " + std::string(what) + " " + quoted(token.text));
+    // from_chars leaves the value unset when out of range: overflow becomes infinite (and rejected
+    // by the callers that need finite values), underflow is as good as zero.
+    if (error == std::errc::result_out_of_range) value = std::strtod(std::string(text).c_str(), nullptr);
+    return value;
+  }
+  double coordinate(const Token& token) const {
+    const double value = number(token, "coordinate");
+    if (!std::isfinite(value)) fail_at(token.line, "non-finite coordinate " + quoted(token.text));
+    return value;
+  }
+
+  template <class T>
+  T binary(std::string_view what, std::endian order = std::endian::native) {
+    binary_seen_ = true;
+    if (remaining() < sizeof(T)) fail("unexpected end of file (reading " + std::string(what) + ")");
+    std::array<char, sizeof(T)> raw;
+    std::memcpy(raw.data(), bytes_.data() + pos_, sizeof(T));
+    if (order != std::endian::native) std::ranges::reverse(raw);
+    T value;
+    std::memcpy(&value, raw.data(), sizeof(T));
+    pos_ += sizeof(T);
+    return value;
+  }
+  void skip_bytes(std::uint64_t count, std::string_view what) {
+    binary_seen_ = true;
+    if (count > remaining()) fail("unexpected end of file (reading " + std::string(what) + ")");
+    pos_ += static_cast<std::size_t>(count);
+  }
+
+  // Refuses a header count whose items, at `min_bytes` each, cannot fit in the rest of the file.
+  void check_count(std::uint64_t count, std::uint64_t min_bytes, std::string_view what) const {
+    if (count > remaining() / min_bytes)
+      fail("absurd " + std::string(what) + " count " + std::to_string(count) + ": cannot fit in the " +
+           std::to_string(remaining()) + " bytes left in the file");
+  }
+
+  [[noreturn]] void fail(const std::string& defect) const { fail_at(line_, defect); }
+  // At the end of the file, the last line: the one a final newline ends, not the empty one after it.
+  [[noreturn]] void fail_at_end(std::string_view what) const {
+    const bool final_newline = !bytes_.empty() && bytes_.back() == '\n';
+    fail_at(final_newline ? line_ - 1 : line_, "unexpected end of file (expected " + std::string(what) + ")");
+  }
+  [[noreturn]] void fail_at(int line, const std::string& defect) const {
+    if (binary_seen_) fail_file(path_, defect);  // line numbers mean nothing after binary data
+    throw InputError(path_ + ":" + std::to_string(line) + ": " + defect);
+  }
+
+ private:
+  // from_chars rejects a leading '+', which text formats allow.
+  static std::string_view without_plus(std::string_view text) {
+    if (text.size() > 1 && text[0] == '+' && text[1] != '-' && text[1] != '+') text.remove_prefix(1);
+    return text;
+  }
+  static bool is_blank(char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\f' || ch == '\v'; }
+
+  void skip_blanks(bool cross_lines) {
+    while (pos_ < bytes_.size()) {
+      const char ch = bytes_[pos_];
+      if (ch == '\n') {
+        if (!cross_lines) return;
+        ++line_;
+        ++pos_;
+      } else if (is_blank(ch)) {
+        ++pos_;
+      } else if (comment_ != '\0' && ch == comment_) {
+        const std::size_t end = bytes_.find('\n', pos_);
+        pos_ = end == std::string_view::npos ? bytes_.size() : end;
+      } else {
+        return;
+      }
+    }
+  }
+  std::optional<Token> token_here() {
+    if (pos_ == bytes_.size() || bytes_[pos_] == '\n') return std::nullopt;
+    const std::size_t begin = pos_;
+    while (pos_ < bytes_.size() && bytes_[pos_] != '\n' && !is_blank(bytes_[pos_]) &&
+           (comment_ == '\0' || bytes_[pos_] != comment_))
+      ++pos_;
+    return Token{bytes_.substr(begin, pos_ - begin), line_};
+  }
+
+  std::string path_;
+  std::string_view bytes_;
+  char comment_;
+  std::size_t pos_ = 0;
+  int line_ = 1;
+  bool binary_seen_ = false;
+};
+
+// Diagonal of the bounding box of the vertices that triangles use (an OBJ file may hold others).
+double used_bounding_box_diagonal(const TriangleSurface& surface) {
+  Eigen::Vector3d lo = surface.points[static_cast<std::size_t>(surface.triangles[0][0])];
+  Eigen::Vector3d hi = lo;
+  for (const Triangle& triangle : surface.triangles)
+    for (const int vertex : triangle) {
+      lo = lo.cwiseMin(surface.points[static_cast<std::size_t>(vertex)]);
+      hi = hi.cwiseMax(surface.points[static_cast<std::size_t>(vertex)]);
+    }
+  return (hi - lo).stableNorm();
+}
+
+// The points that `triangles` use, in their order in `points` (messages number them), the triangles
+// renumbered to them. Sorting, not marking, costs a part of a surface only its own size.
+std::vector<Eigen::Vector3d> used_vertices(const std::vector<Eigen::Vector3d>& points,
+                                           std::vector<Triangle>& triangles) {
+  std::vector<int> used;
+  used.reserve(3 * triangles.size());
+  for (const Triangle& triangle : triangles) used.insert(used.end(), triangle.begin(), triangle.end());
+  std::ranges::sort(used);
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  for (Triangle& triangle : triangles)
+    for (int& vertex : triangle) vertex = static_cast<int>(std::ranges::lower_bound(used, vertex) - used.begin());
+  std::vector<Eigen::Vector3d> kept;
+  kept.reserve(used.size());
+  for (const int vertex : used) kept.push_back(points[static_cast<std::size_t>(vertex)]);
+  return kept;
+}
+
+// How a reader welds: within `tolerance` when it is set, else within `relative` times the bounding-box
+// diagonal. A deliberate weld (`drop_collapsed`) merges vertices that the file keeps apart, so the
+// triangles it collapses or makes repeat another are its doing and are dropped; the tiny default
+// weld leaves such triangles to the validation, which reports them as defects of the file.
+struct Weld {
+  std::optional<double> tolerance;
+  double relative = 0.0;
+  bool drop_collapsed = false;
+};
+
+constexpr Weld kTinyWeld{std::nullopt, 1e-10, false};
+
+// What a reader is asked for, and what it reports.
+struct ReadContext {
+  SurfaceReadOptions options;
+  SurfaceReadReport report;
+};
+
+// Drops the triangles with two equal corners and the repeats of an earlier triangle (the same three
+// vertices, in either orientation), counting both; `tags`, one per triangle, follow the kept ones.
+void drop_collapsed_triangles(TriangleSurface& surface, SurfaceReadReport& report, std::vector<int>* tags) {
+  std::set<Triangle> seen;
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+    const Triangle triangle = surface.triangles[t];
+    Triangle sorted = triangle;
+    std::ranges::sort(sorted);
+    if (sorted[0] == sorted[1] || sorted[1] == sorted[2]) {
+      ++report.degenerate_triangles;
+    } else if (!seen.insert(sorted).second) {
+      ++report.duplicate_triangles;
+    } else {
+      if (tags) (*tags)[kept] = (*tags)[t];
+      surface.triangles[kept++] = triangle;
+    }
+  }
+  surface.triangles.resize(kept);
+  if (tags) tags->resize(kept);
+}
+
+// The common end of every reader: the raw data has finite coordinates and in-range indices. The
+// user's weld tolerance, if any, replaces the format's `weld`; `tags`, one per triangle, follow the
+// triangles kept.
+TriangleSurface finish_surface(const std::string& path, std::vector<Eigen::Vector3d> points,
+                               std::vector<Triangle> triangles, ReadContext& context,
+                               const Weld& format_weld = kTinyWeld, std::vector<int>* tags = nullptr) {
+  if (triangles.empty()) fail_file(path, "no triangles in the file");
+  TriangleSurface surface;
+  surface.name = std::filesystem::path(path).stem().string();
+  surface.source = path;
+  surface.points = std::move(points);
+  surface.triangles = std::move(triangles);
+  const double diagonal = used_bounding_box_diagonal(surface);
+  if (!std::isfinite(diagonal))
+    fail_file(path, "coordinates too far apart: the extent of the surface overflows a double");
+  const Weld weld = context.options.weld_tolerance ? Weld{context.options.weld_tolerance, 0.0, true} : format_weld;
+  // Exact repeats first, uncounted: they are how an STL file shares its vertices (about six times
+  // each), and merging them leaves fewer vertices to scan.
+  weld_vertices(surface, 0.0);
+  context.report.welded_vertices = weld_vertices(surface, weld.tolerance.value_or(weld.relative * diagonal));
+  if (weld.drop_collapsed) {
+    drop_collapsed_triangles(surface, context.report, tags);
+    if (surface.triangles.empty())
+      fail_file(path, "no triangles left after welding: all " + std::to_string(context.report.degenerate_triangles) +
+                          " collapsed");
+  }
+  surface.points = used_vertices(surface.points, surface.triangles);
+  return surface;
+}
+
+// Splits a convex polygon into a fan around its first vertex, keeping its orientation.
+void add_polygon(const std::vector<int>& polygon, std::vector<Triangle>& triangles) {
+  for (std::size_t i = 1; i + 1 < polygon.size(); ++i) triangles.push_back({polygon[0], polygon[i], polygon[i + 1]});
+}
+
+// The valid vertex indices, for messages.
+std::string index_range(long long first, long long count) {
+  if (count == 0) return "the file defines no vertices";
+  return std::to_string(first) + ".." + std::to_string(first + count - 1);
+}
+
+// ---------------------------------------------------------------------------------------------- OBJ
+
+TriangleSurface parse_obj(const std::string& path, std::string_view bytes, ReadContext& context) {
+  FileCursor cursor(path, bytes, '#');
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Triangle> triangles;
+  std::vector<int> triangle_lines;  // positive indices may refer to later vertices: checked at the end
+  std::vector<int> polygon;
+  while (const std::optional<Token> keyword = cursor.next_token()) {
+    if (keyword->text == "v") {
+      Eigen::Vector3d p;
+      for (int axis = 0; axis < 3; ++axis) p[axis] = cursor.coordinate(cursor.expect_token_on_line("vertex coordinate"));
+      points.push_back(p);
+    } else if (keyword->text == "f") {
+      polygon.clear();
+      while (const std::optional<Token> corner = cursor.next_token_on_line()) {
+        // i, i/j, i//k, i/j/k: only the vertex index matters.
+        const Token index_token{corner->text.substr(0, corner->text.find('/')), corner->line};
+        const long long index = cursor.integer(index_token, "vertex index");
+        const long long defined = static_cast<long long>(points.size());
+        if (index == 0) cursor.fail_at(corner->line, "vertex index 0 out of range (OBJ indices start at 1)");
+        if (index < -defined)
+          cursor.fail_at(corner->line, "vertex index " + std::to_string(index) + " out of range (-" +
+                                           std::to_string(defined) + "..-1 with " + std::to_string(defined) +
+                                           " vertices defined so far)");
+        if (index > std::numeric_limits<int>::max())
+          cursor.fail_at(corner->line, "vertex index " + std::to_string(index) + " out of range");
+        polygon.push_back(static_cast<int>(index < 0 ? defined + index : index - 1));
+      }
+      if (polygon.size() < 3)
+        cursor.fail_at(keyword->line, "face with " + std::to_string(polygon.size()) + " vertices (at least 3 needed)");
+      add_polygon(polygon, triangles);
+      triangle_lines.resize(triangles.size(), keyword->line);
+    }
+    // vt, vn, g, o, s, usemtl, mtllib, l, p and the rest do not describe the surface.
+    cursor.skip_line();
+  }
+  const int vertex_count = static_cast<int>(points.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (const int vertex : triangles[t])
+      if (vertex >= vertex_count)
+        cursor.fail_at(triangle_lines[t], "vertex index " + std::to_string(vertex + 1) + " out of range (" +
+                                              index_range(1, vertex_count) + ")");
+  return finish_surface(path, std::move(points), std::move(triangles), context);
+}
+
+// ---------------------------------------------------------------------------------------------- STL
+
+constexpr std::size_t kStlHeaderBytes = 84;  // 80-byte header + uint32 triangle count
+constexpr std::size_t kStlRecordBytes = 50;  // normal, 3 vertices (12 floats) + uint16 attribute
+
+// Little-endian uint32 triangle count of a binary STL.
+std::uint64_t binary_stl_count(std::string_view bytes) {
+  std::uint64_t count = 0;
+  for (std::size_t i = 4; i-- > 0;) count = (count << 8) | static_cast<unsigned char>(bytes[80 + i]);
+  return count;
+}
+
+bool starts_with_solid(std::string_view bytes) {
+  const std::size_t start = bytes.find_first_not_of(" \t\r\n");
+  return start != std::string_view::npos && iequals(bytes.substr(start, 5), "solid");
+}
+
+// A binary header and count almost always hold control characters; text never does.
+bool looks_like_text(std::string_view bytes) {
+  return std::ranges::none_of(bytes.substr(0, 512), [](char ch) {
+    const auto code = static_cast<unsigned char>(ch);
+    return code < 0x20 && !std::isspace(code);
+  });
+}
+
+TriangleSurface parse_binary_stl(const std::string& path, std::string_view bytes, ReadContext& context) {
+  const std::uint64_t count = binary_stl_count(bytes);
+  const std::uint64_t expected = kStlHeaderBytes + kStlRecordBytes * count;
+  if (expected != bytes.size())
+    fail_file(path, "binary STL header announces " + std::to_string(count) + " triangles, which need " +
+                        std::to_string(expected) + " bytes, but the file has " + std::to_string(bytes.size()) + " bytes" +
+                        (expected > bytes.size() ? " (truncated file or corrupt triangle count)"
+                                                 : " (unexpected data after the last triangle)"));
+  if (count > std::numeric_limits<int>::max() / 3)
+    fail_file(path, std::to_string(count) + " triangles: more than a surface can hold");
+  FileCursor cursor(path, bytes);
+  cursor.skip_bytes(kStlHeaderBytes, "header");
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Triangle> triangles;
+  points.reserve(3 * count);  // count checked against the file size above
+  triangles.reserve(count);
+  for (std::uint64_t t = 0; t < count; ++t) {
+    cursor.skip_bytes(12, "normal");  // recomputed from the vertices wherever needed
+    const int first = static_cast<int>(points.size());
+    for (int corner = 0; corner < 3; ++corner) {
+      Eigen::Vector3d p;
+      for (int axis = 0; axis < 3; ++axis) p[axis] = cursor.binary<float>("vertex", std::endian::little);
+      if (!p.allFinite()) fail_file(path, "element " + std::to_string(t + 1) + ": non-finite coordinate");
+      points.push_back(p);
+    }
+    cursor.skip_bytes(2, "attribute");
+    triangles.push_back({first, first + 1, first + 2});
+  }
+  return finish_surface(path, std::move(points), std::move(triangles), context);
+}
+
+TriangleSurface parse_ascii_stl(const std::string& path, std::string_view bytes, ReadContext& context) {
+  FileCursor cursor(path, bytes);
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Triangle> triangles;
+  cursor.expect_keyword("solid");
+  cursor.skip_line();  // the solid's name
+  while (true) {
+    const Token token = cursor.expect_token("'facet' or 'endsolid'");
+    if (iequals(token.text, "endsolid")) {
+      cursor.skip_line();  // the solid's name
+      const std::optional<Token> next = cursor.next_token();
+      if (!next) break;
+      // Some exporters write one solid per part into the same file.
+      if (!iequals(next->text, "solid"))
+        cursor.fail_at(next->line, "expected 'solid' or the end of the file after 'endsolid', found " +
+                                       quoted(next->text));
+      cursor.skip_line();
+      continue;
+    }
+    if (!iequals(token.text, "facet"))
+      cursor.fail_at(token.line, "expected 'facet' or 'endsolid', found " + quoted(token.text));
+    Token next = cursor.expect_token("'normal' or 'outer'");
+    if (iequals(next.text, "normal")) {
+      for (int axis = 0; axis < 3; ++axis) cursor.number(cursor.expect_token("normal component"), "normal component");
+      next = cursor.expect_token("'outer'");
+    }
+    if (!iequals(next.text, "outer")) cursor.fail_at(next.line, "expected 'outer', found " + quoted(next.text));
+    cursor.expect_keyword("loop");
+    const int first = static_cast<int>(points.size());
+    for (int corner = 0; corner < 3; ++corner) {
+      cursor.expect_keyword("vertex");
+      Eigen::Vector3d p;
+      for (int axis = 0; axis < 3; ++axis) p[axis] = cursor.coordinate(cursor.expect_token("vertex coordinate"));
+      points.push_back(p);
+    }
+    cursor.expect_keyword("endloop");
+    cursor.expect_keyword("endfacet");
+    triangles.push_back({first, first + 1, first + 2});
+  }
+  return finish_surface(path, std::move(points), std::move(triangles), context);
+}
+
+TriangleSurface parse_stl(const std::string& path, std::string_view bytes, ReadContext& context) {
+  const bool binary_size = bytes.size() >= kStlHeaderBytes &&
+                           bytes.size() == kStlHeaderBytes + kStlRecordBytes * binary_stl_count(bytes);
+  if (!binary_size && looks_like_text(bytes)) {
+    if (!starts_with_solid(bytes)) fail_file(path, "not an STL file: text that does not start with 'solid'");
+    return parse_ascii_stl(path, bytes, context);
+  }
+  if (bytes.size() < kStlHeaderBytes)
+    fail_file(path, "not an STL file: " + std::to_string(bytes.size()) +
+                        " bytes, too short for a binary STL (at least 84 bytes)");
+  return parse_binary_stl(path, bytes, context);
+}
+
+// ---------------------------------------------------------------------------------------------- OFF
+
+// "OFF" with the optional per-vertex prefixes ST (texture), C (colour), N (normal), whose values follow
+// the coordinates and are skipped; "4OFF" and "nOFF" are not 3D surfaces.
+bool is_off_keyword(std::string_view text) {
+  return text.size() >= 3 && text.ends_with("OFF") &&
+         text.substr(0, text.size() - 3).find_first_not_of("STCN") == std::string_view::npos;
+}
+
+TriangleSurface parse_off(const std::string& path, std::string_view bytes, ReadContext& context) {
+  FileCursor cursor(path, bytes, '#');
+  const Token header = cursor.expect_token("'OFF' header");
+  if (!is_off_keyword(header.text))
+    cursor.fail_at(header.line, "expected the 'OFF' header, found " + quoted(header.text));
+  std::optional<Token> vertex_token = cursor.next_token_on_line();  // counts may follow the keyword
+  if (!vertex_token) vertex_token = cursor.expect_token("vertex count");
+  const long long vertex_count = cursor.integer(*vertex_token, "vertex count");
+  const Token face_token = cursor.expect_token_on_line("face count");
+  const long long face_count = cursor.integer(face_token, "face count");
+  if (vertex_count < 0 || face_count < 0) cursor.fail_at(face_token.line, "negative vertex or face count");
+  // A vertex line holds at least 3 numbers (5 bytes), a face line at least 4 (7 bytes).
+  cursor.check_count(static_cast<std::uint64_t>(vertex_count), 5, "vertex");
+  cursor.check_count(static_cast<std::uint64_t>(face_count), 7, "face");
+  cursor.skip_line();  // the edge count, unused
+
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(static_cast<std::size_t>(vertex_count));
+  for (long long v = 0; v < vertex_count; ++v) {
+    Eigen::Vector3d p;
+    p[0] = cursor.coordinate(cursor.expect_token("vertex coordinate"));
+    for (int axis = 1; axis < 3; ++axis) p[axis] = cursor.coordinate(cursor.expect_token_on_line("vertex coordinate"));
+    points.push_back(p);
+    cursor.skip_line();  // texture coordinates, colour, normal
+  }
+  std::vector<Triangle> triangles;
+  std::vector<int> polygon;
+  for (long long f = 0; f < face_count; ++f) {
+    const Token size_token = cursor.expect_token("face vertex count");
+    const long long size = cursor.integer(size_token, "face vertex count");
+    if (size < 3)
+      cursor.fail_at(size_token.line, "face with " + std::to_string(size) + " vertices (at least 3 needed)");
+    polygon.clear();
+    for (long long k = 0; k < size; ++k) {
+      const Token index_token = cursor.expect_token_on_line("vertex index");
+      const long long index = cursor.integer(index_token, "vertex index");
+      if (index < 0 || index >= vertex_count)
+        cursor.fail_at(index_token.line, "vertex index " + std::to_string(index) + " out of range (" +
+                                             index_range(0, vertex_count) + ")");
+      polygon.push_back(static_cast<int>(index));
+    }
+    add_polygon(polygon, triangles);
+    cursor.skip_line();  // colour
+  }
+  return finish_surface(path, std::move(points), std::move(triangles), context);
+}
+
+// ---------------------------------------------------------------------------------------------- MSH
+
+constexpr long long kGmshTriangle = 2;  // element type of the 3-node triangle
+
+// Nodes of the Gmsh element types, to skip the other elements of a binary file; 0 when unknown.
+int gmsh_nodes_per_element(long long type) {
+  constexpr std::array<int, 32> kNodes = {0, 2,  3,  4,  4,  8, 6,  5,  3,  6,  9,  10, 27, 18, 14, 1,
+                                          8, 20, 15, 13, 9, 10, 12, 15, 15, 21, 4,  5,  6,  20, 35, 56};
+  if (type >= 0 && type < static_cast<long long>(kNodes.size())) return kNodes[static_cast<std::size_t>(type)];
+  if (type == 92) return 64;   // third-order hexahedron
+  if (type == 93) return 125;  // fourth-order hexahedron
+  return 0;
+}
+
+// Gmsh MSH 2.2 and 4.1, ASCII or binary (native byte order, 8-byte size_t). Only the nodes and the
+// 3-node triangles are read; the other sections are skipped, the other elements ignored.
+class MshReader {
+ public:
+  MshReader(const std::string& path, std::string_view bytes) : cursor_(path, bytes) {}
+
+  TriangleSurface read(ReadContext& context) {
+    read_format();
+    while (const std::optional<Token> section = cursor_.next_token()) {
+      if (!section->text.starts_with('$'))
+        cursor_.fail_at(section->line, "expected a section such as '$Nodes', found " + quoted(section->text));
+      const std::string name(section->text.substr(1));
+      const std::string end = "$End" + name;
+      if (name == "Nodes" || name == "Elements") {
+        if (binary_ && version4_) cursor_.skip_line();  // binary data starts on the next line
+        if (name == "Nodes")
+          version4_ ? read_nodes_v4() : read_nodes_v2();
+        else
+          version4_ ? read_elements_v4() : read_elements_v2();
+        const Token end_token = cursor_.expect_token("'" + end + "'");
+        if (end_token.text != end)
+          cursor_.fail_at(end_token.line, "expected '" + end + "', found " + quoted(end_token.text));
+      } else if (!cursor_.skip_past(end)) {
+        cursor_.fail_at(section->line, "section " + quoted(section->text) + " has no '" + end + "'");
+      }
+    }
+    std::vector<Triangle> triangles;
+    triangles.reserve(pending_.size());
+    for (const PendingTriangle& pending : pending_) {
+      Triangle& triangle = triangles.emplace_back();
+      for (int k = 0; k < 3; ++k) {
+        const auto found = node_index_.find(pending.nodes[k]);
+        if (found == node_index_.end())
+          fail_file(cursor_.path(), "element " + std::to_string(pending.element) + ": node " +
+                                        std::to_string(pending.nodes[k]) + " is not defined in $Nodes");
+        triangle[k] = found->second;
+      }
+    }
+    if (triangles.empty()) fail_file(cursor_.path(), "no triangles (element type 2) in the file");
+    return finish_surface(cursor_.path(), std::move(points_), std::move(triangles), context);
+  }
+
+ private:
+  struct PendingTriangle {  // node tags are resolved once all sections are read
+    std::uint64_t element;
+    std::array<std::uint64_t, 3> nodes;
+  };
+
+  void read_format() {
+    const Token start = cursor_.expect_token("'$MeshFormat'");
+    if (start.text != "$MeshFormat")
+      cursor_.fail_at(start.line, "not a Gmsh MSH file: expected '$MeshFormat', found " + quoted(start.text));
+    const Token version = cursor_.expect_token("MSH version");
+    version4_ = version.text == "4.1";
+    if (!version4_ && version.text != "2.2")
+      cursor_.fail_at(version.line, "unsupported MSH version " + quoted(version.text) + " (supported: 2.2, 4.1)");
+    const Token type = cursor_.expect_token("file type");
+    const long long file_type = cursor_.integer(type, "file type");
+    if (file_type != 0 && file_type != 1)
+      cursor_.fail_at(type.line, "file type " + quoted(type.text) + " is neither 0 (ASCII) nor 1 (binary)");
+    binary_ = file_type == 1;
+    const Token size = cursor_.expect_token("data size");
+    if (binary_ && cursor_.integer(size, "data size") != 8)
+      cursor_.fail_at(size.line, "unsupported data size " + quoted(size.text) + " in a binary file (8 expected)");
+    if (binary_) {
+      cursor_.skip_line();
+      const auto one = cursor_.binary<std::int32_t>("endianness check");
+      if (one != 1)
+        cursor_.fail("binary endianness check reads " + std::to_string(one) +
+                     " instead of 1: the file was written with another byte order");
+    }
+    const Token end = cursor_.expect_token("'$EndMeshFormat'");
+    if (end.text != "$EndMeshFormat")
+      cursor_.fail_at(end.line, "expected '$EndMeshFormat', found " + quoted(end.text));
+  }
+
+  // Fields typed 'int' in binary files.
+  long long int_field(std::string_view what) {
+    if (binary_) return cursor_.binary<std::int32_t>(what);
+    return cursor_.integer(cursor_.expect_token(what), what);
+  }
+  // Fields typed 'size_t' in binary files (MSH 4.1 only).
+  std::uint64_t size_field(std::string_view what) {
+    if (binary_) return cursor_.binary<std::uint64_t>(what);
+    const Token token = cursor_.expect_token(what);
+    const long long value = cursor_.integer(token, what);
+    if (value < 0) cursor_.fail_at(token.line, std::string(what) + " " + std::to_string(value) + " is negative");
+    return static_cast<std::uint64_t>(value);
+  }
+  // Node and element tags: 'int' in MSH 2.2 binary files, 'size_t' in MSH 4.1 ones.
+  std::uint64_t tag_field(std::string_view what) {
+    if (!binary_ || version4_) return size_field(what);
+    const long long tag = int_field(what);
+    if (tag < 0) cursor_.fail(std::string(what) + " " + std::to_string(tag) + " is negative");
+    return static_cast<std::uint64_t>(tag);
+  }
+  // MSH 2.2 gives the section counts as text even in binary files, whose data starts on the next line.
+  std::uint64_t text_count(std::string_view what) {
+    const Token token = cursor_.expect_token(what);
+    const long long count = cursor_.integer(token, what);
+    if (count < 0) cursor_.fail_at(token.line, "negative " + std::string(what));
+    if (binary_) cursor_.skip_line();
+    return static_cast<std::uint64_t>(count);
+  }
+  double real_field(std::string_view what) {
+    if (binary_) return cursor_.binary<double>(what);
+    return cursor_.number(cursor_.expect_token(what), what);
+  }
+  Eigen::Vector3d node_point(std::uint64_t tag) {
+    Eigen::Vector3d p;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!binary_) {
+        p[axis] = cursor_.coordinate(cursor_.expect_token("node coordinate"));
+        continue;
+      }
+      p[axis] = cursor_.binary<double>("node coordinate");
+      if (!std::isfinite(p[axis])) cursor_.fail("node " + std::to_string(tag) + ": non-finite coordinate");
+    }
+    return p;
+  }
+  void add_node(std::uint64_t tag, const Eigen::Vector3d& point) {
+    if (!node_index_.emplace(tag, static_cast<int>(points_.size())).second)
+      cursor_.fail("node tag " + std::to_string(tag) + " is defined twice");
+    points_.push_back(point);
+  }
+  void add_triangle(std::uint64_t element) {
+    PendingTriangle& triangle = pending_.emplace_back();
+    triangle.element = element;
+    for (std::uint64_t& node : triangle.nodes) node = tag_field("node tag");
+  }
+  // Skips `count` binary elements of `type`, each made of `ints_besides_nodes` plus its node tags.
+  void skip_binary_elements(long long type, std::uint64_t count, std::uint64_t ints_besides_nodes,
+                            std::uint64_t int_bytes) {
+    const int nodes = gmsh_nodes_per_element(type);
+    if (nodes == 0)
+      cursor_.fail("unsupported element type " + std::to_string(type) + " in a binary file (its node count is unknown)");
+    const std::uint64_t element_bytes = (ints_besides_nodes + static_cast<std::uint64_t>(nodes)) * int_bytes;
+    cursor_.check_count(count, element_bytes, "element");
+    cursor_.skip_bytes(count * element_bytes, "elements");
+  }
+  void check_block(std::uint64_t in_block, std::uint64_t read, std::uint64_t announced, std::string_view what) {
+    if (in_block > announced - read)
+      cursor_.fail("a block of " + std::to_string(in_block) + " " + std::string(what) + "s exceeds the " +
+                   std::to_string(announced) + " announced by the section header");
+  }
+
+  void read_nodes_v2() {
+    const std::uint64_t count = text_count("number of nodes");
+    cursor_.check_count(count, binary_ ? 4 + 3 * 8 : 7, "node");
+    points_.reserve(points_.size() + count);
+    node_index_.reserve(node_index_.size() + count);
+    for (std::uint64_t i = 0; i < count; ++i) {
+      const std::uint64_t tag = tag_field("node tag");
+      add_node(tag, node_point(tag));
+    }
+  }
+
+  void read_elements_v2() {
+    const std::uint64_t count = text_count("number of elements");
+    cursor_.check_count(count, binary_ ? 8 : 7, "element");
+    if (!binary_) {  // one element per line: tag, type, number of tags, tags, nodes
+      for (std::uint64_t i = 0; i < count; ++i) {
+        const std::uint64_t element = tag_field("element tag");
+        if (cursor_.integer(cursor_.expect_token_on_line("element type"), "element type") == kGmshTriangle) {
+          const long long tags = cursor_.integer(cursor_.expect_token_on_line("number of tags"), "number of tags");
+          for (long long k = 0; k < tags; ++k) cursor_.expect_token_on_line("element tag");
+          add_triangle(element);
+        }
+        cursor_.skip_line();
+      }
+      return;
+    }
+    // Binary elements come in blocks sharing a header: type, number of elements, number of tags.
+    for (std::uint64_t read = 0; read < count;) {
+      const long long type = int_field("element type");
+      const long long in_block = int_field("number of elements in block");
+      const long long tags = int_field("number of tags");
+      if (in_block < 1 || tags < 0) cursor_.fail("malformed element block header");
+      const auto elements = static_cast<std::uint64_t>(in_block);
+      check_block(elements, read, count, "element");
+      if (type == kGmshTriangle) {
+        for (std::uint64_t i = 0; i < elements; ++i) {
+          const std::uint64_t element = tag_field("element tag");
+          cursor_.skip_bytes(static_cast<std::uint64_t>(tags) * 4, "element tags");
+          add_triangle(element);
+        }
+      } else {
+        skip_binary_elements(type, elements, 1 + static_cast<std::uint64_t>(tags), 4);
+      }
+      read += elements;
+    }
+  }
+
+  void read_nodes_v4() {
+    const std::uint64_t blocks = size_field("number of node blocks");
+    const std::uint64_t count = size_field("number of nodes");
+    size_field("minimum node tag");
+    size_field("maximum node tag");
+    cursor_.check_count(blocks, binary_ ? 20 : 7, "node block");
+    cursor_.check_count(count, binary_ ? 32 : 7, "node");
+    points_.reserve(points_.size() + count);
+    node_index_.reserve(node_index_.size() + count);
+    std::vector<std::uint64_t> tags;
+    std::uint64_t read = 0;
+    for (std::uint64_t b = 0; b < blocks; ++b) {
+      const long long dimension = int_field("entity dimension");
+      int_field("entity tag");
+      const long long parametric = int_field("parametric flag");
+      const std::uint64_t in_block = size_field("number of nodes in block");
+      if (dimension < 0 || dimension > 3) cursor_.fail("entity dimension " + std::to_string(dimension) + " is not 0..3");
+      if (parametric != 0 && parametric != 1) cursor_.fail("parametric flag " + std::to_string(parametric) + " is not 0 or 1");
+      check_block(in_block, read, count, "node");
+      tags.clear();  // all the tags of a block precede its coordinates
+      for (std::uint64_t i = 0; i < in_block; ++i) tags.push_back(tag_field("node tag"));
+      // Parametric nodes add u (curve), u v (surface) or u v w (volume) after x y z.
+      const long long parameters = parametric == 1 ? dimension : 0;
+      for (const std::uint64_t tag : tags) {
+        const Eigen::Vector3d point = node_point(tag);
+        for (long long k = 0; k < parameters; ++k) real_field("parametric coordinate");
+        add_node(tag, point);
+      }
+      read += in_block;
+    }
+    if (read != count)
+      cursor_.fail("node blocks hold " + std::to_string(read) + " nodes, the section header announces " +
+                   std::to_string(count));
+  }
+
+  void read_elements_v4() {
+    const std::uint64_t blocks = size_field("number of element blocks");
+    const std::uint64_t count = size_field("number of elements");
+    size_field("minimum element tag");
+    size_field("maximum element tag");
+    cursor_.check_count(blocks, binary_ ? 20 : 7, "element block");
+    cursor_.check_count(count, binary_ ? 16 : 3, "element");
+    std::uint64_t read = 0;
+    for (std::uint64_t b = 0; b < blocks; ++b) {
+      int_field("entity dimension");
+      int_field("entity tag");
+      const long long type = int_field("element type");
+      const std::uint64_t in_block = size_field("number of elements in block");
+      check_block(in_block, read, count, "element");
+      if (type == kGmshTriangle) {
+        for (std::uint64_t i = 0; i < in_block; ++i) add_triangle(tag_field("element tag"));
+      } else if (binary_) {
+        skip_binary_elements(type, in_block, 1, 8);
+      } else {
+        for (std::uint64_t i = 0; i < in_block; ++i) {  // one element per line: tag, nodes
+          cursor_.expect_token("element tag");
+          cursor_.skip_line();
+        }
+      }
+      read += in_block;
+    }
+    if (read != count)
+      cursor_.fail("element blocks hold " + std::to_string(read) + " elements, the section header announces " +
+                   std::to_string(count));
+  }
+
+  FileCursor cursor_;
+  bool binary_ = false;
+  bool version4_ = false;
+  std::vector<Eigen::Vector3d> points_;
+  std::unordered_map<std::uint64_t, int> node_index_;
+  std::vector<PendingTriangle> pending_;
+};
+
+TriangleSurface parse_msh(const std::string& path, std::string_view bytes, ReadContext& context) {
+  return MshReader(path, bytes).read(context);
+}
+
+// -------------------------------------------------------------------------------------------- parts
+
+// The parts of a surface: its triangles joined through shared edges, numbered from 0 in the order of
+// their first triangles.
+struct Parts {
+  std::vector<int> of_triangle;
+  int count = 0;
+};
+
+Parts surface_parts(const std::vector<Triangle>& triangles) {
+  std::vector<std::pair<detail::Edge, std::size_t>> edges;  // (edge, triangle)
+  edges.reserve(3 * triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (std::size_t k = 0; k < 3; ++k)
+      edges.push_back({detail::make_edge(triangles[t][k], triangles[t][(k + 1) % 3]), t});
+  std::ranges::sort(edges);
+  detail::UnionFind sets(triangles.size());
+  for (std::size_t i = 1; i < edges.size(); ++i)
+    if (edges[i].first == edges[i - 1].first) sets.join(edges[i - 1].second, edges[i].second);
+  Parts parts;
+  std::vector<int> part_of_root(triangles.size(), -1);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    int& part = part_of_root[sets.find(t)];
+    if (part < 0) part = parts.count++;
+    parts.of_triangle.push_back(part);
+  }
+  return parts;
+}
+
+// One surface per part, named NAME_1, NAME_2, ...
+std::vector<TriangleSurface> split_into_parts(const TriangleSurface& surface) {
+  const Parts parts = surface_parts(surface.triangles);
+  std::vector<TriangleSurface> split(static_cast<std::size_t>(parts.count));
+  for (std::size_t p = 0; p < split.size(); ++p) {
+    split[p].name = surface.name + "_" + std::to_string(p + 1);
+    split[p].source = surface.source;
+  }
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t)
+    split[static_cast<std::size_t>(parts.of_triangle[t])].triangles.push_back(surface.triangles[t]);
+  for (TriangleSurface& part : split) part.points = used_vertices(surface.points, part.triangles);
+  return split;
+}
+
+// -------------------------------------------------------------------------------------------- TSurf
+
+constexpr double kTsurfWeldMetres = 1.0;              // coincident vertices of real files lie up to this apart
+constexpr double kTsurfRelativeWeldTolerance = 1e-6;  // times the bounding-box diagonal, when the unit is unknown
+
+// Metres in one AXIS_UNIT of a GOCAD coordinate system (quoted or not); 0 when the unit is unknown.
+double metres_per_unit(std::string_view unit) {
+  constexpr std::array<std::pair<std::string_view, double>, 13> kUnits{{
+      {"m", 1.0}, {"meter", 1.0}, {"meters", 1.0}, {"metre", 1.0}, {"metres", 1.0},
+      {"km", 1000.0}, {"kilometer", 1000.0}, {"kilometers", 1000.0}, {"kilometre", 1000.0}, {"kilometres", 1000.0},
+      {"ft", 0.3048}, {"foot", 0.3048}, {"feet", 0.3048}}};
+  if (unit.size() >= 2 && unit.front() == '"' && unit.back() == '"') unit = unit.substr(1, unit.size() - 2);
+  for (const auto& [name, metres] : kUnits)
+    if (iequals(unit, name)) return metres;
+  return 0.0;
+}
+
+std::string_view trimmed(std::string_view text) {
+  const std::size_t first = text.find_first_not_of(" \t\r");
+  if (first == std::string_view::npos) return {};
+  return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
+}
+
+// A TSurf file's surface (all its objects), with the TFACE each triangle comes from, for messages.
+struct TsurfFile {
+  struct Tface {
+    int line;    // of its TFACE keyword
+    int object;  // index in `objects`
+  };
+  TriangleSurface surface;
+  std::vector<int> tface_of_triangle;  // index in `tfaces`
+  std::vector<Tface> tfaces;
+  std::vector<std::string> objects;  // each object's HEADER name, empty when it has none
+};
+
+// GOCAD TSurf: one or more objects `GOCAD TSurf 1` ... `END`, each numbering its own vertices. Read:
+// the geometry (VRTX, PVRTX, ATOM, PATOM and TRGL, in TFACE blocks), the HEADER's name and the
+// AXIS_UNIT; other keyword lines (BSTONE, BORDER, PROPERTIES, ...) and blocks in braces are skipped.
+class TsurfReader {
+ public:
+  TsurfReader(const std::string& path, std::string_view bytes) : cursor_(path, bytes, '#') {}
+
+  TsurfFile read(ReadContext& context) {
+    start_object(cursor_.expect_token("'GOCAD TSurf' header"));
+    while (const std::optional<Token> keyword = cursor_.next_token()) {
+      if (object_line_ == 0)
+        start_object(*keyword);
+      else
+        read_keyword(*keyword);
+    }
+    if (object_line_ != 0)
+      cursor_.fail_at_end("'END' of the object that starts at line " + std::to_string(object_line_));
+    file_.surface = finish_surface(cursor_.path(), std::move(points_), std::move(triangles_), context, weld(),
+                                   &file_.tface_of_triangle);
+    return std::move(file_);
+  }
+
+ private:
+  struct Definition {  // of a vertex id
+    int point;
+    int line;
+  };
+
+  int object() const { return static_cast<int>(file_.objects.size()) - 1; }
+
+  void start_object(const Token& gocad) {
+    if (!iequals(gocad.text, "GOCAD")) {
+      if (file_.objects.empty())
+        cursor_.fail_at(gocad.line, "not a GOCAD TSurf file: it starts with " + quoted(gocad.text) +
+                                        " instead of 'GOCAD TSurf'");
+      cursor_.fail_at(gocad.line, "expected 'GOCAD TSurf' (another object) or the end of the file after END, found " +
+                                      quoted(gocad.text));
+    }
+    const Token type = cursor_.expect_token_on_line("GOCAD object type");
+    if (!iequals(type.text, "TSurf"))
+      cursor_.fail_at(type.line, "not a TSurf: a GOCAD " + quoted(type.text) +
+                                     " object (only TSurf objects, triangulated surfaces, can be read)");
+    cursor_.skip_line();  // the version
+    object_line_ = gocad.line;
+    file_.objects.emplace_back();
+    ids_.clear();
+    unit_ = 0.0;
+  }
+
+  void read_keyword(const Token& keyword) {
+    const std::string_view text = keyword.text;
+    if (text == "VRTX" || text == "PVRTX") {
+      add_vertex(keyword);
+    } else if (text == "ATOM" || text == "PATOM") {
+      add_atom(keyword);
+    } else if (text == "TRGL") {
+      add_triangle(keyword);
+    } else if (text == "TFACE") {
+      file_.tfaces.push_back({keyword.line, object()});
+      cursor_.skip_line();
+    } else if (text == "END") {
+      object_units_.push_back(unit_);
+      object_line_ = 0;
+      cursor_.skip_line();
+    } else if (text == "AXIS_UNIT") {
+      read_axis_unit();
+    } else if (iequals(text, "GOCAD")) {
+      cursor_.fail_at(keyword.line, "'GOCAD' starts an object before the END of the object that starts at line " +
+                                        std::to_string(object_line_));
+    } else {
+      skip_keyword(keyword);
+    }
+  }
+
+  // The geometry of an object lies in its TFACE blocks: a vertex before them has no part to go to.
+  void require_tface(const Token& keyword) const {
+    if (file_.tfaces.empty() || file_.tfaces.back().object != object())
+      cursor_.fail_at(keyword.line, quoted(keyword.text) + " outside a TFACE block (no TFACE since the object's " +
+                                        "start at line " + std::to_string(object_line_) + ")");
+  }
+
+  void add_vertex(const Token& keyword) {
+    require_tface(keyword);
+    define(cursor_.expect_token_on_line("vertex id"), static_cast<int>(points_.size()));
+    Eigen::Vector3d& p = points_.emplace_back();
+    for (int axis = 0; axis < 3; ++axis)
+      p[axis] = cursor_.coordinate(cursor_.expect_token_on_line("vertex coordinate"));
+    cursor_.skip_line();  // PVRTX's property values
+  }
+
+  // An atom is another id for an existing vertex.
+  void add_atom(const Token& keyword) {
+    require_tface(keyword);
+    const Token id = cursor_.expect_token_on_line("atom id");
+    define(id, point(keyword, cursor_.expect_token_on_line("vertex id")));
+    cursor_.skip_line();  // PATOM's property values
+  }
+
+  void add_triangle(const Token& keyword) {
+    require_tface(keyword);
+    Triangle& triangle = triangles_.emplace_back();
+    for (int& corner : triangle) corner = point(keyword, cursor_.expect_token_on_line("vertex id"));
+    file_.tface_of_triangle.push_back(static_cast<int>(file_.tfaces.size()) - 1);
+    cursor_.skip_line();
+  }
+
+  void define(const Token& id, int point) {
+    const long long value = cursor_.integer(id, "vertex id");
+    const auto [found, inserted] = ids_.try_emplace(value, Definition{point, id.line});
+    if (!inserted)
+      cursor_.fail_at(id.line, "vertex id " + std::to_string(value) +
+                                   " is defined twice in the object (first at line " +
+                                   std::to_string(found->second.line) + ")");
+  }
+
+  // The point a vertex id of the current object names.
+  int point(const Token& keyword, const Token& id) const {
+    const long long value = cursor_.integer(id, "vertex id");
+    const auto found = ids_.find(value);
+    if (found == ids_.end())
+      cursor_.fail_at(id.line, std::string(keyword.text) + " refers to unknown vertex id " + std::to_string(value) +
+                                   " (no VRTX, PVRTX, ATOM or PATOM of the object defines it before)");
+    return found->second.point;
+  }
+
+  // AXIS_UNIT "m" "m" "m": the unit common to the three axes; unknown (0) when they differ.
+  void read_axis_unit() {
+    std::optional<double> unit;
+    while (const std::optional<Token> token = cursor_.next_token_on_line()) {
+      const double metres = metres_per_unit(token->text);
+      unit = !unit || *unit == metres ? metres : 0.0;
+    }
+    unit_ = unit.value_or(0.0);
+    cursor_.skip_line();
+  }
+
+  // Skips a keyword line and the block in braces it opens, if any, keeping the HEADER's name.
+  void skip_keyword(const Token& keyword) {
+    const std::string_view rest = cursor_.rest_of_line();
+    const std::size_t open = rest.find('{');
+    if (open == std::string_view::npos) return;
+    std::string block(rest.substr(open + 1));
+    if (const std::size_t close = block.find('}'); close != std::string::npos) {
+      block.resize(close);
+    } else {
+      const std::optional<std::string_view> more = cursor_.text_until("}");
+      if (!more) cursor_.fail_at(keyword.line, "the " + quoted(keyword.text) + " block has no closing '}'");
+      block += '\n';
+      block += *more;
+      cursor_.skip_line();  // what follows the '}'
+    }
+    if (keyword.text == "HEADER") read_header(block);
+  }
+
+  // HEADER { key:value lines }: the name.
+  void read_header(std::string_view block) {
+    while (!block.empty()) {
+      const std::size_t end = block.find('\n');
+      const std::string_view line = trimmed(block.substr(0, end));
+      block = end == std::string_view::npos ? std::string_view() : block.substr(end + 1);
+      if (line.starts_with("name:")) file_.objects.back() = std::string(trimmed(line.substr(5)));
+    }
+  }
+
+  // One metre in the file's unit when every object gives the same known one; a deliberate weld.
+  Weld weld() const {
+    const bool known = !object_units_.empty() && std::ranges::all_of(object_units_, [&](double unit) {
+      return unit > 0.0 && unit == object_units_[0];
+    });
+    return {known ? std::optional(kTsurfWeldMetres / object_units_[0]) : std::nullopt, kTsurfRelativeWeldTolerance,
+            true};
+  }
+
+  FileCursor cursor_;
+  TsurfFile file_;
+  std::vector<Eigen::Vector3d> points_;
+  std::vector<Triangle> triangles_;
+  std::unordered_map<long long, Definition> ids_;  // of the current object
+  int object_line_ = 0;                            // of the current object's GOCAD line; 0 after its END
+  double unit_ = 0.0;                              // metres per AXIS_UNIT of the current object, 0 if unknown
+  std::vector<double> object_units_;
+};
+
+// Names a TFACE for messages: "TFACE 2 (line 40) of object 'fault A'".
+std::string tface_label(const TsurfFile& file, int tface) {
+  const TsurfFile::Tface& block = file.tfaces[static_cast<std::size_t>(tface)];
+  const std::string& name = file.objects[static_cast<std::size_t>(block.object)];
+  return "TFACE " + std::to_string(tface + 1) + " (line " + std::to_string(block.line) + ") of object " +
+         (name.empty() ? std::to_string(block.object + 1) : quoted(name, 100));
+}
+
+[[noreturn]] void fail_several_parts(const TsurfFile& file, const Parts& parts) {
+  constexpr int kMaxNamed = 20;
+  const auto named = static_cast<std::size_t>(std::min(parts.count, kMaxNamed));
+  std::vector<std::set<int>> tfaces(named);
+  std::vector<int> triangles(named, 0);
+  for (std::size_t t = 0; t < parts.of_triangle.size(); ++t)
+    if (const auto part = static_cast<std::size_t>(parts.of_triangle[t]); part < named) {
+      tfaces[part].insert(file.tface_of_triangle[t]);
+      ++triangles[part];
+    }
+  std::string message =
+      std::to_string(parts.count) + " parts (triangles joined through shared edges) where one surface is expected:";
+  for (std::size_t p = 0; p < named; ++p) {
+    message += " part " + std::to_string(p + 1) + ", " + std::to_string(triangles[p]) +
+               (triangles[p] == 1 ? " triangle in " : " triangles in ");
+    for (const int tface : tfaces[p])
+      message += (tface == *tfaces[p].begin() ? "" : " and ") + tface_label(file, tface);
+    message += ";";
+  }
+  if (parts.count > kMaxNamed) message += " and " + std::to_string(parts.count - kMaxNamed) + " more parts;";
+  fail_file(file.surface.source,
+            message + " --split-parts (read_surface_parts in the library) reads each part as its own surface");
+}
+
+// A TSurf file as one surface: refused, naming its parts, when it has several.
+TriangleSurface parse_tsurf(const std::string& path, std::string_view bytes, ReadContext& context) {
+  TsurfFile file = TsurfReader(path, bytes).read(context);
+  const Parts parts = surface_parts(file.surface.triangles);
+  if (parts.count > 1) fail_several_parts(file, parts);
+  return std::move(file.surface);
+}
+
+// A TSurf file whatever its parts.
+TriangleSurface parse_whole_tsurf(const std::string& path, std::string_view bytes, ReadContext& context) {
+  return TsurfReader(path, bytes).read(context).surface;
+}
+
+// ------------------------------------------------------------------------------------------ formats
+
+using Parser = TriangleSurface (*)(const std::string& path, std::string_view bytes, ReadContext& context);
+
+constexpr std::array<std::pair<std::string_view, Parser>, 5> kFormats{
+    {{".obj", parse_obj}, {".stl", parse_stl}, {".off", parse_off}, {".msh", parse_msh}, {".ts", parse_tsurf}}};
+
+std::string lowercase_extension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::ranges::transform(extension, extension.begin(),
+                         [](char ch) { return static_cast<char>(std::tolower(static_cast<unsigned char>(ch))); });
+  return extension;
+}
+
+Parser parser_for(const std::string& path) {
+  const std::string extension = lowercase_extension(path);
+  std::string supported;
+  for (const auto& [known, parser] : kFormats) {
+    if (extension == known) return parser;
+    supported += (supported.empty() ? "" : ", ") + std::string(known);
+  }
+  fail_file(path, (extension.empty() ? "no file extension" : "unsupported surface format '" + extension + "'") +
+                      " (supported: " + supported + ")");
+}
+
+TriangleSurface read_with(Parser parser, const std::string& path, const SurfaceReadOptions& options = {},
+                          SurfaceReadReport* report = nullptr) {
+  ReadContext context{options, {}};
+  TriangleSurface surface = parser(path, read_file_bytes(path), context);
+  if (report) *report = context.report;
+  return surface;
+}
+
+// ------------------------------------------------------------------------------------------ welding
+
+struct Cell {
+  std::int64_t x, y, z;
+  bool operator==(const Cell&) const = default;
+};
+
+struct CellHash {
+  std::size_t operator()(const Cell& cell) const noexcept {
+    std::uint64_t h = static_cast<std::uint64_t>(cell.x) * 0x9E3779B97F4A7C15ULL;
+    h ^= static_cast<std::uint64_t>(cell.y) * 0xC2B2AE3D27D4EB4FULL;
+    h ^= static_cast<std::uint64_t>(cell.z) * 0x165667B19E3779F9ULL;
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+};
+
+// Points bucketed in a uniform grid, each cell listing its points through a linked list.
+class PointGrid {
+ public:
+  // The points lie in [origin, origin + extent] on every axis.
+  PointGrid(const Eigen::Vector3d& origin, double cell_size, double extent)
+      : origin_(origin), cell_size_(cell_size), last_cell_(std::floor(extent / cell_size)) {}
+
+  // A stored point within `tolerance` of p, or -1. The point's own cell first: it holds the exact
+  // duplicates, which are most of the points of an STL file.
+  int find_within(const Eigen::Vector3d& p, double tolerance, const std::vector<Eigen::Vector3d>& stored) const {
+    const Cell own = cell_of(p);
+    if (const int found = find_in_cell(own, p, tolerance, stored); found >= 0) return found;
+    const Cell lo = cell_of((p.array() - tolerance).matrix());
+    const Cell hi = cell_of((p.array() + tolerance).matrix());
+    for (std::int64_t x = lo.x; x <= hi.x; ++x)
+      for (std::int64_t y = lo.y; y <= hi.y; ++y)
+        for (std::int64_t z = lo.z; z <= hi.z; ++z)
+          if (const Cell cell{x, y, z}; !(cell == own))
+            if (const int found = find_in_cell(cell, p, tolerance, stored); found >= 0) return found;
+    return -1;
+  }
+  void insert(int index, const Eigen::Vector3d& p) {
+    if (next_.size() <= static_cast<std::size_t>(index)) next_.resize(static_cast<std::size_t>(index) + 1, -1);
+    auto [slot, inserted] = first_.try_emplace(cell_of(p), index);
+    if (!inserted) {
+      next_[static_cast<std::size_t>(index)] = slot->second;
+      slot->second = index;
+    }
+  }
+
+ private:
+  int find_in_cell(const Cell& cell, const Eigen::Vector3d& p, double tolerance,
+                   const std::vector<Eigen::Vector3d>& stored) const {
+    const auto found = first_.find(cell);
+    if (found == first_.end()) return -1;
+    for (int i = found->second; i >= 0; i = next_[static_cast<std::size_t>(i)])
+      if ((stored[static_cast<std::size_t>(i)] - p).squaredNorm() <= tolerance * tolerance) return i;
+    return -1;
+  }
+  // Clamped to one cell beyond the occupied ones: a query box next to the largest doubles can reach
+  // infinity, and would otherwise span an unbounded number of cells.
+  Cell cell_of(const Eigen::Vector3d& p) const {
+    const Eigen::Array3d q = ((p - origin_) / cell_size_).array().floor().cwiseMax(-1.0).cwiseMin(last_cell_ + 1.0);
+    return {static_cast<std::int64_t>(q.x()), static_cast<std::int64_t>(q.y()), static_cast<std::int64_t>(q.z())};
+  }
+
+  Eigen::Vector3d origin_;
+  double cell_size_;
+  double last_cell_;
+  std::unordered_map<Cell, int, CellHash> first_;
+  std::vector<int> next_;
+};
+
+}  // namespace
+
+int weld_vertices(TriangleSurface& surface, double tolerance) {
+  if (!(tolerance >= 0.0) || std::isinf(tolerance))
+    throw std::invalid_argument("weld_vertices: the tolerance must be finite and >= 0");
+  std::vector<Eigen::Vector3d>& points = surface.points;
+  const std::size_t count = points.size();
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t)
+    for (const int vertex : surface.triangles[t])
+      if (vertex < 0 || static_cast<std::size_t>(vertex) >= count)
+        throw InputError((surface.source.empty() ? surface.name : surface.source) + ": triangle " +
+                         std::to_string(t + 1) + " refers to vertex index " + std::to_string(vertex) +
+                         ", out of range (0.." + std::to_string(static_cast<long long>(count) - 1) + ")");
+
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const Eigen::Vector3d& p : points)
+    if (p.allFinite()) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  const double extent = lo.x() <= hi.x() ? (hi - lo).maxCoeff() : 0.0;
+  // Cell coordinates come from differences of points, which must not overflow.
+  if (!std::isfinite(extent))
+    throw InputError((surface.source.empty() ? surface.name : surface.source) +
+                     ": coordinates too far apart to weld: the extent of the points overflows a double");
+  // Cells 4 tolerances wide: most points then look up a single cell. Never finer than 2^-40 of the
+  // extent, so that cell coordinates fit in 64 bits whatever the tolerance.
+  double cell_size = std::max(4.0 * tolerance, extent * 0x1p-40);
+  if (cell_size == 0.0) cell_size = 1.0;  // a single location and a zero tolerance
+  PointGrid grid(lo.allFinite() ? lo : Eigen::Vector3d::Zero(), cell_size, extent);
+
+  std::vector<Eigen::Vector3d> kept;
+  std::vector<int> new_index(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const Eigen::Vector3d& p = points[i];
+    // Non-finite points are kept apart, for the validation to report.
+    int match = p.allFinite() ? grid.find_within(p, tolerance, kept) : -1;
+    if (match < 0) {
+      match = static_cast<int>(kept.size());
+      kept.push_back(p);
+      if (p.allFinite()) grid.insert(match, p);
+    }
+    new_index[i] = match;
+  }
+  for (Triangle& triangle : surface.triangles)
+    for (int& vertex : triangle) vertex = new_index[static_cast<std::size_t>(vertex)];
+  const int merged = static_cast<int>(count - kept.size());
+  points = std::move(kept);
+  return merged;
+}
+
+TriangleSurface read_obj(const std::string& path) { return read_with(parse_obj, path); }
+TriangleSurface read_stl(const std::string& path) { return read_with(parse_stl, path); }
+TriangleSurface read_off(const std::string& path) { return read_with(parse_off, path); }
+TriangleSurface read_msh_triangles(const std::string& path) { return read_with(parse_msh, path); }
+TriangleSurface read_tsurf(const std::string& path) { return read_with(parse_tsurf, path); }
+
+TriangleSurface read_surface(const std::string& path, const SurfaceReadOptions& options, SurfaceReadReport* report) {
+  return read_with(parser_for(path), path, options, report);
+}
+
+std::vector<TriangleSurface> read_surface_parts(const std::string& path, const SurfaceReadOptions& options,
+                                                SurfaceReadReport* report) {
+  // The TSurf parser refuses a file of several parts: read it whole.
+  const Parser parser = lowercase_extension(path) == ".ts" ? parse_whole_tsurf : parser_for(path);
+  return split_into_parts(read_with(parser, path, options, report));
+}
+
+}  // namespace meccano

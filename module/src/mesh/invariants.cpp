@@ -1,0 +1,180 @@
+#include <meccano/mesh/invariants.hpp>
+
+#include <meccano/mesh/quality.hpp>
+
+#include "geometry/compensated_sum.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace meccano {
+namespace {
+
+__extension__ using int128 = __int128;
+
+class Checker {
+ public:
+  Checker(const TetMesh& mesh, const MeshInvariantOptions& options) : mesh_(mesh), options_(options) {}
+
+  MeshInvariantReport run() {
+    check_sizes();
+    if (!report_.ok()) return report_;
+    check_tets();
+    check_faces();
+    check_volume();
+    return report_;
+  }
+
+ private:
+  template <class... Parts>
+  void problem(const Parts&... parts) {
+    if (report_.problem_count++ >= options_.max_reported) return;
+    std::ostringstream message;
+    (message << ... << parts);
+    report_.problems.push_back(message.str());
+  }
+
+  void check_sizes() {
+    const std::size_t n = mesh_.tets.size();
+    if (mesh_.kinds.size() != n || mesh_.neighbours.size() != n || mesh_.face_tags.size() != n)
+      problem("per-tet arrays have different sizes");
+    if (mesh_.grid.size() != mesh_.points.size()) problem("per-vertex arrays have different sizes");
+    for (TetId t = 0; t < mesh_.num_tets(); ++t)
+      for (VertexId v : mesh_.tets[t])
+        if (v < 0 || v >= mesh_.num_vertices()) problem("tet ", t, " has vertex ", v, " out of range");
+  }
+
+  void check_tets() {
+    for (TetId t = 0; t < mesh_.num_tets(); ++t) {
+      const auto& v = mesh_.tets[t];
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+          if (v[i] == v[j]) problem("tet ", t, " repeats vertex ", v[i]);
+      // A remeshed tet has no computational shape to check (its grid image may even be inverted); the
+      // computational volume still adds up, since a flip keeps the boundary of the tets it replaces.
+      const int sign = mesh_.bisectable(t) ? grid_orientation(mesh_, t) : 1;
+      if (sign == 0) problem("tet ", t, " is degenerate in computational space");
+      else if ((sign < 0) != mesh_.kinds[t].negative())
+        problem("tet ", t, " has orientation ", sign, " but records the opposite");
+      if (options_.physical) {
+        const auto o = mesh_.oriented_tet(t);
+        const double volume = signed_volume(mesh_.points[o[0]], mesh_.points[o[1]], mesh_.points[o[2]], mesh_.points[o[3]]);
+        physical_volume_.add(volume);
+        if (!(volume > 0.0)) {
+          ++report_.inverted_physical;
+          problem("tet ", t, " is inverted or flat in physical space (volume ", volume, ")");
+        }
+      }
+    }
+  }
+
+  // The box side (0..5) that all three grid points lie on, or -1.
+  int box_side_of(const std::array<VertexId, 3>& face) const {
+    const GridPoint upper = mesh_.meccano.upper_corner();
+    for (int axis = 0; axis < 3; ++axis)
+      for (int upper_side = 0; upper_side < 2; ++upper_side) {
+        const std::int64_t plane = upper_side ? upper[axis] : 0;
+        if (mesh_.grid[face[0]][axis] == plane && mesh_.grid[face[1]][axis] == plane &&
+            mesh_.grid[face[2]][axis] == plane)
+          return 2 * axis + upper_side;
+      }
+    return -1;
+  }
+
+  // Twice the area of a face lying on a plane normal to `axis`, exactly.
+  int128 twice_area_on_plane(const std::array<VertexId, 3>& face, int axis) const {
+    const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+    const GridPoint& a = mesh_.grid[face[0]];
+    const GridPoint& b = mesh_.grid[face[1]];
+    const GridPoint& c = mesh_.grid[face[2]];
+    const int128 cross = int128{b[u] - a[u]} * (c[w] - a[w]) - int128{b[w] - a[w]} * (c[u] - a[u]);
+    return cross < 0 ? -cross : cross;
+  }
+
+  void check_faces() {
+    const auto faces = sorted_face_records(mesh_);
+    std::array<int128, 6> side_area{};
+    for (std::size_t i = 0; i < faces.size();) {
+      std::size_t j = i + 1;
+      while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+      const FaceRecord& f = faces[i];
+      const FaceTag tag = mesh_.face_tags[f.tet][f.local_face];
+      if (j - i > 2) {
+        problem("face (", f.key[0], ", ", f.key[1], ", ", f.key[2], ") is shared by ", j - i, " tets");
+      } else if (j - i == 2) {
+        ++report_.interior_faces;
+        const FaceRecord& g = faces[i + 1];
+        if (mesh_.neighbours[f.tet][f.local_face] != g.tet || mesh_.neighbours[g.tet][g.local_face] != f.tet)
+          problem("tets ", f.tet, " and ", g.tet, " share a face but are not recorded as neighbours");
+        if (is_box_side_tag(tag)) problem("interior face of tet ", f.tet, " carries a box-side tag");
+        if (tag != mesh_.face_tags[g.tet][g.local_face])
+          problem("interior face between tets ", f.tet, " and ", g.tet, " is tagged differently on each side");
+      } else {
+        ++report_.boundary_faces;
+        const int side = box_side_of(f.key);
+        if (mesh_.neighbours[f.tet][f.local_face] != no_tet)
+          problem("tet ", f.tet, " face ", f.local_face, " is unshared but has a neighbour");
+        if (side < 0) {
+          problem("tet ", f.tet, " face ", f.local_face, " is unshared but not on the box boundary (a hole)");
+        } else {
+          side_area[side] += twice_area_on_plane(f.key, side / 2);
+          if (tag != box_side_tag(static_cast<BoxSide>(side)))
+            problem("boundary face of tet ", f.tet, " is not tagged ", box_side_name(static_cast<BoxSide>(side)));
+        }
+      }
+      i = j;
+    }
+    const auto& cells = mesh_.meccano.cells;
+    for (int side = 0; side < 6; ++side) {
+      const int axis = side / 2;
+      const int128 expected = int128{2} * cells[(axis + 1) % 3] * cells[(axis + 2) % 3] * grid_cell * grid_cell;
+      if (side_area[side] != expected)
+        problem("boundary faces do not tile box side ", box_side_name(static_cast<BoxSide>(side)));
+    }
+  }
+
+  void check_volume() {
+    int128 six_volumes = 0;
+    for (TetId t = 0; t < mesh_.num_tets(); ++t) {
+      const auto o = mesh_.oriented_tet(t);
+      std::array<std::array<int128, 3>, 3> e{};
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) e[r][c] = int128{mesh_.grid[o[r + 1]][c]} - mesh_.grid[o[0]][c];
+      six_volumes += e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                     e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                     e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+    }
+    const auto& cells = mesh_.meccano.cells;
+    const int128 expected = int128{6} * cells[0] * cells[1] * cells[2] * grid_cell * grid_cell * grid_cell;
+    if (six_volumes != expected) problem("computational volume differs from the box volume");
+    if (options_.physical) {
+      report_.physical_volume = physical_volume_.value();
+      const Eigen::Vector3d extent = mesh_.meccano.box.extent();
+      const double box_volume = extent.prod();
+      if (std::abs(report_.physical_volume - box_volume) > 1e-10 * box_volume)
+        problem("physical volume ", report_.physical_volume, " differs from the box volume ", box_volume);
+    }
+  }
+
+  const TetMesh& mesh_;
+  const MeshInvariantOptions& options_;
+  MeshInvariantReport report_;
+  CompensatedSum physical_volume_;
+};
+
+}  // namespace
+
+std::string MeshInvariantReport::summary() const {
+  std::ostringstream out;
+  out << problem_count << " problem(s)";
+  for (const auto& p : problems) out << "\n  " << p;
+  if (problem_count > static_cast<std::int64_t>(problems.size()))
+    out << "\n  ... and " << problem_count - static_cast<std::int64_t>(problems.size()) << " more";
+  return out.str();
+}
+
+MeshInvariantReport verify_mesh(const TetMesh& mesh, const MeshInvariantOptions& options) {
+  return Checker(mesh, options).run();
+}
+
+}  // namespace meccano

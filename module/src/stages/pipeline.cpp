@@ -1,0 +1,584 @@
+#include <meccano/stages/pipeline.hpp>
+
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/error.hpp>
+#include <meccano/mesh/invariants.hpp>
+
+#include "mesh/topology_helpers.hpp"
+
+#include <omp.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <limits>
+#include <sstream>
+
+namespace meccano {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+template <class... Parts>
+void report(const InsertionOptions& options, const Parts&... parts) {
+  if (!options.progress) return;
+  std::ostringstream line;
+  (line << ... << parts);
+  options.progress(line.str());
+}
+
+// A MeshingError with the surfaces it concerns, which a retry at a finer l_r may mend.
+class SurfaceFailure : public MeshingError {
+ public:
+  SurfaceFailure(std::vector<int> failing, const std::string& message)
+      : MeshingError(message), surfaces(std::move(failing)) {
+    std::ranges::sort(surfaces);
+    surfaces.erase(std::unique(surfaces.begin(), surfaces.end()), surfaces.end());
+  }
+  std::vector<int> surfaces;  // sorted, each once
+};
+
+// Runs one surface's stage; its MeshingError becomes a SurfaceFailure naming the surface.
+template <class Run>
+auto for_surface(int s, const std::string& name, Run&& run) {
+  try {
+    return run();
+  } catch (const SurfaceFailure&) {
+    throw;
+  } catch (const MeshingError& failure) {
+    throw SurfaceFailure({s}, name + ": " + failure.what());
+  }
+}
+
+// Cheap invariant check at the end of a stage: a failure here is a bug, not bad input.
+void check_stage(const TetMesh& mesh, const char* stage) {
+  const auto check = verify_mesh(mesh, {.physical = true});
+  if (!check.ok()) throw MeshingError(std::string("mesh invalid after the ") + stage + " stage: " + check.summary());
+}
+
+InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options,
+                           std::span<const SideRule> side_rules, std::span<const double> resolutions) {
+  InsertionResult result;
+  result.mesh = std::move(mesh);
+  if (static_cast<int>(surfaces.size()) > max_interfaces)
+    throw InputError("at most " + std::to_string(max_interfaces) + " surfaces can be inserted");
+
+  // Step 1: the volumetric approximation of each surface.
+  result.surfaces.reserve(surfaces.size());
+  for (int index = 0; index < static_cast<int>(surfaces.size()); ++index) {
+    const TriangleSurface& surface = surfaces[index];
+    const auto start = std::chrono::steady_clock::now();
+    SurfaceInsertion& inserted = result.surfaces.emplace_back();
+    inserted.name = surface.name;
+    inserted.resolution = resolutions[index];
+    std::vector<TetRegion*> earlier;
+    for (int s = 0; s < index; ++s) earlier.push_back(&result.surfaces[s].volumetric);
+    const TriangleBVH tree(surface);
+    inserted.volumetric = for_surface(index, surface.name, [&] {
+      return approximate_volume(result.mesh, tree, {inserted.resolution}, inserted.volumetric_stats, earlier);
+    });
+    inserted.volumetric_seconds = seconds_since(start);
+    const auto& stats = inserted.volumetric_stats;
+    report(options, "volumetric ", surface.name, ": ", stats.refinement_passes, " refinement passes, ",
+           stats.bisections, " bisections, ", stats.tets_intersecting, " tets meet S; grown to ", stats.tets,
+           " tets (", stats.euler_node_stars, " node stars, ", stats.cavity_tets, " cavity tets, ", stats.axis_tets,
+           " axis tets); mesh ", result.mesh.num_tets(), " tets");
+  }
+  check_stage(result.mesh, "volumetric");
+  if (options.last_stage == Stage::volumetric || surfaces.empty()) return result;
+
+  // Step 2: the surface approximation of each surface, healed. Healing a later surface refines the
+  // mesh near it, which can disturb an earlier S_M close by, so all are checked again and re-healed.
+  std::vector<TriangleBVH> trees;
+  for (const TriangleSurface& surface : surfaces) trees.emplace_back(surface);
+  const int count = static_cast<int>(surfaces.size());
+  auto other_regions = [&](int s) {
+    std::vector<TetRegion*> regions;
+    for (int other = 0; other < count; ++other)
+      if (other != s) regions.push_back(&result.surfaces[other].volumetric);
+    return regions;
+  };
+  for (int round = 0; round < 3; ++round) {
+    bool healed_any = false;
+    for (int s = 0; s < count; ++s) {
+      SurfaceInsertion& inserted = result.surfaces[s];
+      if (round > 0 && check_surface_approximation(result.mesh, inserted.volumetric, s).healed()) continue;
+      const auto start = std::chrono::steady_clock::now();
+      SurfaceApproximationOptions approximation = options.approximation;
+      approximation.side_rule = side_rules[s];
+      inserted.healing_stats = for_surface(s, inserted.name, [&] {
+        return approximate_surface(result.mesh, inserted.volumetric, surfaces[s], trees[s], s, approximation,
+                                   other_regions(s));
+      });
+      inserted.approximation_seconds += seconds_since(start);
+      healed_any = true;
+      const auto& h = inserted.healing_stats;
+      report(options, "approximation ", inserted.name, ": side ", h.side > 0 ? "+" : "-", ", ", h.passes,
+             " healing passes; ", h.faces, " faces, ", h.rim_nodes, " rim nodes; extension ", h.extension_faces,
+             ", corbels ", h.corbels, ", reflex corners filled ", h.reflex_corners_filled, " left ", h.reflex_corners_left,
+             ", tets with two faces ",
+             h.tets_with_two_faces, ", triangles with two rim edges ", h.triangles_with_two_rim_edges,
+             ", cross-surface edges ", h.cross_surface_edges, ", dividing edges ", h.dividing_edges, ", chord edges ", h.chord_edges, "; mesh ",
+             result.mesh.num_tets(), " tets");
+    }
+    if (!healed_any) break;
+  }
+  for (int s = 0; s < count; ++s) {
+    const auto check = check_surface_approximation(result.mesh, result.surfaces[s].volumetric, s);
+    if (!check.healed())
+      throw SurfaceFailure({s}, "the surface approximation of " + result.surfaces[s].name +
+                                    " is disturbed by the other surfaces: " + check.describe());
+  }
+  check_stage(result.mesh, "approximation");
+  if (options.last_stage == Stage::approximation) return result;
+
+  // Step 3: every S_M node moves onto its surface. Tets may be tangled until step 4.
+  for (int s = 0; s < count; ++s) {
+    SurfaceInsertion& inserted = result.surfaces[s];
+    const auto start = std::chrono::steady_clock::now();
+    inserted.projection = project_onto_surface(result.mesh, inserted.volumetric, s, inserted.healing_stats.side,
+                                               surfaces[s], trees[s], options.projection);
+    inserted.projection_seconds = seconds_since(start);
+    const auto& p = inserted.projection.stats;
+    report(options, "projection ", inserted.name, ": ", p.nodes, " nodes (", p.rim_nodes, " on the rim, ",
+           p.creases.nodes, " on ", p.creases.lines, " creases) moved by up to ", p.largest_move, ", now within ",
+           p.largest_distance_after, " of S; ", p.inverted_tets, " tets inverted (smoothing untangles them)");
+  }
+  const auto check = verify_mesh(result.mesh, {.physical = false});
+  if (!check.ok()) throw MeshingError("mesh invalid after the projection stage: " + check.summary());
+  result.quality_before_smoothing = summarize_quality(result.mesh);
+  if (options.last_stage == Stage::projection) return result;
+
+  // Step 4: untangling and smoothing, every surface's nodes moving within it.
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<SurfaceProjection*> projections;
+  for (SurfaceInsertion& inserted : result.surfaces) projections.push_back(&inserted.projection);
+  SmoothingOptions smoothing_options = options.smoothing;
+  if (options.progress)
+    smoothing_options.on_sweep = [&options, caller_on_sweep = options.smoothing.on_sweep](int sweep, const SweepRecord& record) {
+      if (caller_on_sweep) caller_on_sweep(sweep, record);
+      report(options, "smoothing sweep ", sweep, ": ", record.inverted, " tets inverted, quality min ", record.min_quality,
+             " mean ", record.mean_quality,
+             record.target == SmoothingTarget::equilateral ? " towards the equilateral target" : "", ", ",
+             record.nodes_optimised, " nodes optimised");
+    };
+  result.smoothing = smooth_mesh(result.mesh, projections, smoothing_options);
+  result.smoothing_seconds = seconds_since(start);
+  const SmoothingStats& smoothing = result.smoothing;
+  const SweepRecord last = smoothing.sweeps.empty() ? SweepRecord{} : smoothing.sweeps.back();
+  report(options, "smoothing: ",
+         smoothing.inner_nodes + smoothing.box_nodes + smoothing.surface_nodes + smoothing.rim_nodes + smoothing.crease_nodes,
+         " free nodes (", smoothing.surface_nodes, " on surfaces, ", smoothing.rim_nodes, " on rims, ",
+         smoothing.crease_nodes, " on creases), ", smoothing.colours,
+         " colours; ", smoothing.inverted_before, " inverted tets before, ", smoothing.inverted_after, " after ",
+         smoothing.sweeps.size(), " sweeps (untangled after ", smoothing.untangling_sweeps,
+         smoothing.fallback_sweep > 0 ? ", towards the equilateral target from sweep " + std::to_string(smoothing.fallback_sweep)
+                                      : std::string(),
+         "); quality min ", last.min_quality, " mean ", last.mean_quality);
+  if (!smoothing.untangled()) return result;  // the caller may retry, or reports the failure
+  check_stage(result.mesh, "smoothing");
+
+  if (options.improve != Improvement::none) {
+    const auto started = std::chrono::steady_clock::now();
+    ImprovementOptions improvement = options.improvement;
+    improvement.topology = options.improve == Improvement::topology;
+    if (options.progress) improvement.progress = options.progress;
+    std::vector<TetRegion*> regions;
+    for (SurfaceInsertion& inserted : result.surfaces) regions.push_back(&inserted.volumetric);
+    const ImprovementStats& improved = result.improvement.emplace(
+        improve_worst_tets(result.mesh, projections, improvement, options.smoothing, regions));
+    result.improvement_seconds = seconds_since(started);
+    report(options, "improvement: ", improved.passes, " passes over the tets below ", improvement.threshold,
+           " (", improved.tets_below_before, " before, ", improved.tets_below_after, " after), ", improved.nodes_moved,
+           " of ", improved.node_updates, " node updates moved",
+           improvement.topology ? "; " + std::to_string(improved.rounds) + " rounds of flips: " + describe(improved.flips)
+                                : std::string(),
+           "; smallest quality ", improved.min_quality_before, " -> ", improved.min_quality_after, " (equilateral)");
+    check_stage(result.mesh, "improvement");
+  }
+  result.quality_after_smoothing = summarize_quality(result.mesh);
+  return result;
+}
+
+// Sets OpenMP's thread count for the calling thread's parallel regions and restores it on exit.
+class ThreadCount {
+ public:
+  explicit ThreadCount(int threads) : previous_(omp_get_max_threads()) {
+    if (threads > 0) omp_set_num_threads(threads);
+  }
+  ~ThreadCount() { omp_set_num_threads(previous_); }
+  ThreadCount(const ThreadCount&) = delete;
+  ThreadCount& operator=(const ThreadCount&) = delete;
+
+ private:
+  int previous_;
+};
+
+std::string tets_still_inverted(const InsertionResult& result) {
+  return std::to_string(result.smoothing.inverted_after) + " tets are still inverted after " +
+         std::to_string(result.smoothing.sweeps.size()) + " sweeps";
+}
+
+std::string untangling_failure(const InsertionResult& result) {
+  return "smoothing could not untangle the mesh: " + tets_still_inverted(result);
+}
+
+// What an untangling failure means, and what may mend it besides the finer l_r the final message
+// suggests anyway.
+std::string untangling_explanation(const InsertionOptions& options) {
+  return options.smoothing.mode == SmoothingMode::band
+             ? "smoothing could not untangle the mesh, which the whole-mesh mode (--smoothing whole, "
+               "SmoothingMode::whole_mesh) may do"
+             : "smoothing could not untangle the mesh";
+}
+
+// A run of the stages that failed, for the final message: where it ran and why it failed, one line, and
+// what that kind of failure means (empty if the reason says it), which the message gives once however
+// many runs failed alike.
+struct FailedAttempt {
+  std::string settings;
+  std::string reason;
+  std::string explanation;
+};
+
+const char* side_rule_name(SideRule rule) {
+  switch (rule) {
+    case SideRule::positive_first: return "positive";
+    case SideRule::negative_first: return "negative";
+    case SideRule::positive_only: return "positive-only";
+    case SideRule::negative_only: return "negative-only";
+  }
+  return "";
+}
+
+// "0.05" when every surface has the same value, else "lower 0.025, upper 0.05".
+template <class Value, class Text>
+std::string per_surface(std::span<const TriangleSurface> surfaces, std::span<const Value> values, Text text) {
+  if (std::ranges::all_of(values, [&](const Value& value) { return value == values.front(); }))
+    return text(values.front());
+  std::string listed;
+  for (std::size_t s = 0; s < surfaces.size(); ++s) listed += (s > 0 ? ", " : "") + surfaces[s].name + " " + text(values[s]);
+  return listed;
+}
+
+// "l_r = 0.05, side positive" (the rule's --side name), per surface where they differ.
+std::string attempt_settings(std::span<const TriangleSurface> surfaces, std::span<const double> resolutions,
+                             std::span<const SideRule> rules) {
+  const auto number = [](double value) {
+    std::ostringstream text;
+    text << value;
+    return text.str();
+  };
+  return "l_r = " + per_surface(surfaces, resolutions, number) + ", side " +
+         per_surface(surfaces, rules, [](SideRule rule) { return std::string(side_rule_name(rule)); });
+}
+
+// The message of an insertion that failed for good: one line per attempt, the explanations of the kinds
+// of failure met, once each, and `outcome`: why no further attempt was made.
+std::string final_failure(std::span<const FailedAttempt> failed, const std::string& outcome) {
+  std::ostringstream message;
+  message << "the insertion failed (" << failed.size() << (failed.size() == 1 ? " attempt):" : " attempts):");
+  std::vector<std::string> explanations;
+  for (std::size_t k = 0; k < failed.size(); ++k) {
+    message << "\n  attempt " << k + 1 << " (" << failed[k].settings << "): " << failed[k].reason;
+    if (!failed[k].explanation.empty() && std::ranges::find(explanations, failed[k].explanation) == explanations.end())
+      explanations.push_back(failed[k].explanation);
+  }
+  message << '\n';
+  for (const std::string& explanation : explanations) message << explanation << "; ";
+  message << outcome;
+  return message.str();
+}
+
+// The surfaces with an S_M node in an inverted tet, in order.
+std::vector<int> surfaces_next_to_inverted_tets(const InsertionResult& result) {
+  const TetMesh& mesh = result.mesh;
+  std::vector<int> surface_of(mesh.points.size(), -1);
+  for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s)
+    for (VertexId v : result.surfaces[s].projection.nodes) surface_of[v] = s;
+  std::vector<std::uint8_t> next(result.surfaces.size(), 0);
+  for (TetId t = 0; t < mesh.num_tets(); ++t)
+    if (is_inverted(mesh, t))
+      for (VertexId v : mesh.tets[t])
+        if (surface_of[v] >= 0) next[surface_of[v]] = 1;
+  std::vector<int> surfaces;
+  for (int s = 0; s < static_cast<int>(next.size()); ++s)
+    if (next[s]) surfaces.push_back(s);
+  return surfaces;
+}
+
+// The side rules of a second attempt: each surface next to an inverted tet (`next`), if its rule lets
+// it change sides, builds S_M on the other side only. Empty if no surface may change.
+std::vector<SideRule> other_side_rules(const InsertionResult& result, std::span<const int> next,
+                                       std::span<const SideRule> rules) {
+  std::vector<SideRule> retry(rules.begin(), rules.end());
+  bool changed = false;
+  for (int s : next) {
+    if (rules[s] != SideRule::positive_first && rules[s] != SideRule::negative_first) continue;
+    retry[s] = result.surfaces[s].healing_stats.side > 0 ? SideRule::negative_only : SideRule::positive_only;
+    changed = true;
+  }
+  return changed ? retry : std::vector<SideRule>{};
+}
+
+// An untangling failure concerns the surfaces next to inverted tets (`next`), or all if none is.
+SurfaceFailure untangling_surface_failure(std::vector<int> next, int count, const std::string& message) {
+  if (next.empty())
+    for (int s = 0; s < count; ++s) next.push_back(s);
+  return SurfaceFailure(std::move(next), message);
+}
+
+// The stages at the given resolutions. A surface whose S_M cannot be untangled on one side of S may be
+// on the other: the stages run again from the input mesh with those surfaces' S_M on their other side,
+// as healing itself does. Throws SurfaceFailure when that fails too. Each failed run is added to `failed`.
+InsertionResult insert_on_either_side(const TetMesh& mesh, std::span<const TriangleSurface> surfaces,
+                                      const InsertionOptions& options, std::span<const double> resolutions,
+                                      std::vector<FailedAttempt>& failed) {
+  const int count = static_cast<int>(surfaces.size());
+  const std::vector<SideRule> rules(surfaces.size(), options.approximation.side_rule);
+  auto run = [&](std::span<const SideRule> sides) {
+    try {
+      return run_stages(mesh, surfaces, options, sides, resolutions);
+    } catch (const SurfaceFailure& failure) {
+      failed.push_back({attempt_settings(surfaces, resolutions, sides), failure.what(), ""});
+      throw;
+    }
+  };
+  auto untangling_failed = [&](const InsertionResult& tangled, std::span<const SideRule> sides) {
+    failed.push_back(
+        {attempt_settings(surfaces, resolutions, sides), tets_still_inverted(tangled), untangling_explanation(options)});
+    return untangling_failure(tangled);
+  };
+  InsertionResult result = run(rules);
+  if (options.last_stage != Stage::smoothing || surfaces.empty() || result.smoothing.untangled()) return result;
+  const std::string failure = untangling_failed(result, rules);
+  std::vector<int> next = surfaces_next_to_inverted_tets(result);
+  const std::vector<SideRule> retry = other_side_rules(result, next, rules);
+  if (retry.empty()) throw untangling_surface_failure(std::move(next), count, failure);
+  report(options, "retrying with S_M on the other side of the surfaces next to inverted tets (", failure, ")");
+  try {
+    result = run(retry);
+  } catch (const SurfaceFailure& other_side) {
+    next.insert(next.end(), other_side.surfaces.begin(), other_side.surfaces.end());
+    throw SurfaceFailure(std::move(next), failure + "; on the other side: " + other_side.what());
+  }
+  if (!result.smoothing.untangled())
+    throw untangling_surface_failure(surfaces_next_to_inverted_tets(result), count,
+                                     failure + "; on the other side: " + untangling_failed(result, retry));
+  result.side_retry = failure;
+  return result;
+}
+
+}  // namespace
+
+namespace {
+
+// The length of a surface's rim: its edges used by one triangle.
+double rim_length(const TriangleSurface& surface) {
+  const auto edges = detail::edges_with_triangles(surface.triangles);
+  double length = 0.0;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    if (j - i == 1) length += (surface.points[edges[i].first.second] - surface.points[edges[i].first.first]).norm();
+    i = j;
+  }
+  return length;
+}
+
+}  // namespace
+
+std::int64_t estimate_tets(const MeccanoGrid& meccano, std::int64_t meccano_tets,
+                           std::span<const TriangleSurface> surfaces, double resolution) {
+  // V_M covers S with the cubes of its level: a plane with unit normal n crosses
+  // |n_x| / (h_y h_z) + |n_y| / (h_x h_z) + |n_z| / (h_x h_y) cubes of sides h per unit area, and the
+  // rim adds about one cube per cube width. Tets per cube crossed and per rim cube, by level type (the
+  // levels 3k, 3k+1, 3k+2 cut a cube into 6, 12 and 24 tets): fitted on 13 real and synthetic faults and
+  // two test surfaces at E/25 to E/100, all within 34 % (doc/benchmarks.md, "Predictable cost").
+  static constexpr std::array<double, 3> tets_per_cube = {27.5, 33.7, 61.1};
+  static constexpr std::array<double, 3> tets_per_rim_cube = {85.6, 111.6, 159.5};
+  const int level = level_for_resolution(meccano, resolution);
+  const Eigen::Vector3d h = std::ldexp(1.0, -(level / 3)) * meccano.cell_size;
+  const Eigen::Vector3d per_area(1.0 / (h.y() * h.z()), 1.0 / (h.x() * h.z()), 1.0 / (h.x() * h.y()));
+  double cubes = 0.0, rim_cubes = 0.0;
+  for (const TriangleSurface& surface : surfaces) {
+    for (const auto& [a, b, c] : surface.triangles) {
+      const Eigen::Vector3d area = 0.5 * (surface.points[b] - surface.points[a]).cross(surface.points[c] - surface.points[a]);
+      cubes += area.cwiseAbs().dot(per_area);
+    }
+    rim_cubes += rim_length(surface) / std::cbrt(h.prod());
+  }
+  const double total = static_cast<double>(meccano_tets) + tets_per_cube[level % 3] * cubes +
+                       tets_per_rim_cube[level % 3] * rim_cubes;
+  return total < 0x1p62 ? static_cast<std::int64_t>(total) : std::int64_t{1} << 62;
+}
+
+void require_tet_estimate_within(std::int64_t estimated_tets, std::int64_t max_tets, const std::string& what) {
+  if (estimated_tets <= max_tets) return;
+  std::ostringstream message;
+  message.precision(3);
+  message << what << " would make about " << static_cast<double>(estimated_tets) << " tets (about "
+          << static_cast<double>(estimated_tets) * estimated_bytes_per_tet / (1 << 30) << " GiB of memory), above the "
+          << "limit of " << max_tets << " tets; use a coarser setting or raise the limit (--max-tets, "
+          << "InsertionOptions::max_tets)";
+  throw InputError(message.str());
+}
+
+// How close each surface comes to every other one and to the box sides: the room its V_M has.
+struct Clearances {
+  std::vector<std::vector<double>> between;  // surface distances, symmetric
+  std::vector<double> to_box;
+};
+
+Clearances clearances(std::span<const TriangleSurface> surfaces, const Box& box) {
+  const std::size_t count = surfaces.size();
+  Clearances clearance{std::vector<std::vector<double>>(count, std::vector<double>(count, 0.0)),
+                       std::vector<double>(count, std::numeric_limits<double>::infinity())};
+  for (std::size_t s = 0; s < count; ++s) {
+    for (const Eigen::Vector3d& p : surfaces[s].points)
+      clearance.to_box[s] = std::min({clearance.to_box[s], (p - box.min).minCoeff(), (box.max - p).minCoeff()});
+    const TriangleBVH tree(surfaces[s]);
+    for (std::size_t other = 0; other < s; ++other)
+      clearance.between[s][other] = clearance.between[other][s] = surface_distance(surfaces[other], tree);
+  }
+  return clearance;
+}
+
+// The room two surfaces at these l_r need between them for their S_M to stay apart: each S_M lies
+// within growth_band × its reach of its surface, on one side of it. Measured on stress case 50 of seed 1
+// (two surfaces 0.0052 apart): S_M healed at a reach of 0.0039 (6.3 M tets) and not at 0.0068.
+double room_needed(const MeccanoGrid& meccano, double resolution, double other_resolution) {
+  return growth_band * std::max(growth_reach(meccano, resolution), growth_reach(meccano, other_resolution));
+}
+
+// The failing surfaces and those whose S_M could touch theirs: a finer l_r for one alone would leave
+// the other's S_M in place.
+std::vector<int> surfaces_to_refine(const MeccanoGrid& meccano, const Clearances& clearance,
+                                    std::span<const double> resolutions, std::vector<int> failing) {
+  const std::size_t count = failing.size();
+  for (std::size_t k = 0; k < count; ++k) {
+    const int s = failing[k];
+    for (int other = 0; other < static_cast<int>(resolutions.size()); ++other)
+      if (std::ranges::find(failing, other) == failing.end() &&
+          clearance.between[s][other] < room_needed(meccano, resolutions[s], resolutions[other]))
+        failing.push_back(other);
+  }
+  std::ranges::sort(failing);
+  return failing;
+}
+
+// The next l_r of a surface to refine: half its l_r, or the coarsest finer one that leaves its S_M room
+// between it and the surfaces refined with it, and the box: the gap decides the first finer l_r,
+// instead of halving attempt after attempt.
+double finer_resolution(const MeccanoGrid& meccano, const Clearances& clearance, std::span<const int> refined, int s,
+                        double resolution) {
+  double gap = clearance.to_box[s];
+  for (int other : refined)
+    if (other != s) gap = std::min(gap, clearance.between[s][other]);
+  double finer = resolution / 2.0;
+  for (int level = level_for_resolution(meccano, finer); room_needed(meccano, finer, finer) >= gap; ++level) {
+    if (level >= finest_level) break;  // the surfaces practically touch: the tet limit decides
+    finer = longest_edge_at_level(meccano, level);  // the coarsest l_r of the next level
+  }
+  return finer;
+}
+
+// The insertion at l_r, and where it fails, again with the failing surfaces at a finer l_r.
+InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
+  const auto pipeline_start = std::chrono::steady_clock::now();
+  std::int64_t estimated_tets = mesh.num_tets();
+  if (!surfaces.empty()) {
+    if (!(options.resolution > 0.0))
+      throw InputError("the resolution l_r must be positive (got " + std::to_string(options.resolution) + ")");
+    std::ostringstream what;
+    what << "the resolution l_r = " << options.resolution;
+    estimated_tets = estimate_tets(mesh.meccano, mesh.num_tets(), surfaces, options.resolution);
+    require_tet_estimate_within(estimated_tets, options.max_tets, what.str());
+  }
+  const ThreadCount threads(options.threads);
+  std::vector<double> resolutions(surfaces.size(), options.resolution);
+  std::vector<std::string> failures;  // why each finer retry was made, for the result
+  std::vector<FailedAttempt> failed;   // every run of the stages that failed, for the final message
+  Clearances clearance;                // computed at the first failure
+  for (int retry = 0;; ++retry) {
+    std::vector<int> failing;
+    try {
+      InsertionResult result = insert_on_either_side(mesh, surfaces, options, resolutions, failed);
+      result.finer_retries = std::move(failures);
+      result.estimated_tets = estimated_tets;
+      result.seconds = seconds_since(pipeline_start);
+      return result;
+    } catch (const SurfaceFailure& failure) {
+      failures.emplace_back(failure.what());
+      failing = failure.surfaces;
+    }
+    if (retry == options.finer_retries)
+      throw MeshingError(final_failure(failed, "more finer retries (--finer-retries, InsertionOptions::finer_retries; " +
+                                                   std::to_string(options.finer_retries) + " here) may succeed"));
+    std::int64_t estimate = mesh.num_tets();
+    std::ostringstream finer;
+    finer.precision(6);
+    if (clearance.to_box.empty()) clearance = clearances(surfaces, mesh.meccano.box);
+    const std::vector<int> refined = surfaces_to_refine(mesh.meccano, clearance, resolutions, failing);
+    const std::vector<double> previous = resolutions;
+    for (int s : refined) {
+      resolutions[s] = finer_resolution(mesh.meccano, clearance, refined, s, previous[s]);
+      finer << (finer.tellp() > 0 ? ", " : "") << surfaces[s].name << " at l_r = " << resolutions[s];
+    }
+    for (std::size_t s = 0; s < surfaces.size(); ++s)
+      estimate += estimate_tets(mesh.meccano, 0, surfaces.subspan(s, 1), resolutions[s]);
+    if (estimate > options.max_tets) throw MeshingError(final_failure(failed, "a finer l_r would exceed the tet limit"));
+    report(options, "retrying with ", finer.str(), " (", failures.back(), ")");
+  }
+}
+
+MeshGroups output_groups(const InsertionResult& result, Stage last_stage) {
+  MeshGroups groups;
+  const MeshGroups standard = standard_groups(result.mesh);
+  groups.volumes = standard.volumes;
+  for (const FaceGroup& group : standard.surfaces)
+    if (group.name.rfind("interface_", 0) != 0) groups.surfaces.push_back(group);  // box sides
+  for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s) {
+    const SurfaceInsertion& inserted = result.surfaces[s];
+    if (last_stage != Stage::smoothing) {
+      TetGroup volume{"volumetric_" + inserted.name, domain_tag + 1 + s, {}};
+      for (TetId t = 0; t < result.mesh.num_tets(); ++t)
+        if (inserted.volumetric[t]) volume.tets.push_back(t);
+      groups.volumes.push_back(std::move(volume));
+    }
+    if (inserted.healing_stats.side != 0)
+      groups.surfaces.push_back(
+          {"interface_" + inserted.name, interface_tag(s),
+           interface_faces(result.mesh, inserted.volumetric, s, inserted.healing_stats.side).faces});
+  }
+  return groups;
+}
+
+std::vector<SurfaceInterface> surface_interfaces(const InsertionResult& result) {
+  std::vector<SurfaceInterface> interfaces;
+  const TetMesh& mesh = result.mesh;
+  for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s) {
+    const SurfaceInsertion& inserted = result.surfaces[s];
+    if (inserted.healing_stats.side == 0) continue;
+    const InterfaceFaces oriented = interface_faces(mesh, inserted.volumetric, s, inserted.healing_stats.side);
+    SurfaceInterface& interface = interfaces.emplace_back();
+    interface.name = inserted.name;
+    interface.tag = interface_tag(s);
+    interface.faces.reserve(oriented.faces.size());
+    for (std::size_t i = 0; i < oriented.faces.size(); ++i) {
+      const FaceRef behind = oriented.faces[i];
+      const TetId front = mesh.neighbours[behind.tet][behind.local_face];
+      const auto& v = oriented.triangles[i];
+      const Eigen::Vector3d normal =
+          (mesh.points[v[1]] - mesh.points[v[0]]).cross(mesh.points[v[2]] - mesh.points[v[0]]).normalized();
+      interface.faces.push_back({v, normal, behind, {front, mesh.face_towards(front, behind.tet)}});
+    }
+  }
+  return interfaces;
+}
+
+}  // namespace meccano

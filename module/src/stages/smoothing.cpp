@@ -1,0 +1,874 @@
+#include <meccano/stages/smoothing.hpp>
+
+#include <meccano/stages/improvement.hpp>
+
+#include <meccano/mesh/quality.hpp>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <optional>
+
+namespace meccano {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+// A node has up to 3 parameters; unused ones have zero columns in the Jacobian, hence zero gradient and
+// Hessian entries, so the Newton step leaves them at 0.
+using Parameters = Vector3d;
+using Jacobian = Matrix3d;
+
+constexpr double infinity = std::numeric_limits<double>::infinity();
+
+// ---------------------------------------------------------------------------------------------------
+// The distortion of one tet as a function of one of its vertices.
+//
+// With the vertex at x, S = A W^-1 is affine in x: dS = dx bᵀ with b = W^-T c, where c = e_k for local
+// vertex k = 1..3 and c = -(1,1,1) for vertex 0 (A's columns are p_k - p_0). So N = ||S||² has gradient
+// 2 S b and Hessian 2|b|² I, and σ = det S is linear in x with gradient cof(S) b. Writing r = √(σ² + 4δ²),
+// h'(σ) = h / r, and for f = N / (3 h^(2/3)):
+//   ∇f = f a,  a = ∇N / N - (2/3) ∇σ / r,
+//   ∇²f = f (a aᵀ + 2|b|²/N I - ∇N ∇Nᵀ / N² + (2/3) σ / r³ ∇σ ∇σᵀ).
+
+Matrix3d edge_matrix(const std::array<Vector3d, 4>& p) {
+  Matrix3d a;
+  a << p[1] - p[0], p[2] - p[0], p[3] - p[0];
+  return a;
+}
+
+Matrix3d cofactor(const Matrix3d& s) {
+  Matrix3d c;
+  c << s.col(1).cross(s.col(2)), s.col(2).cross(s.col(0)), s.col(0).cross(s.col(1));
+  return c;
+}
+
+double regularised_distortion(double frobenius_squared, double sigma, double delta) {
+  // h = (σ + r) / 2 with r = √(σ² + 4δ²); for σ < 0 the equal form 2δ² / (r - σ) avoids cancellation.
+  const double r = std::sqrt(sigma * sigma + 4.0 * delta * delta);
+  const double h = sigma >= 0.0 ? 0.5 * (sigma + r) : 2.0 * delta * delta / (r - sigma);
+  return h > 0.0 ? frobenius_squared / (3.0 * std::cbrt(h * h)) : infinity;
+}
+
+// One tet as a function of the free vertex's displacement d from where the star was taken. Only that
+// vertex moves, so S changes by a rank-one term, S(d) = S0 + d bᵀ, and exactly (the matrix determinant
+// lemma for σ):
+//   N(d) = N0 + 2 d·u + |d|² β   with u = S0 b, β = |b|²;      σ(d) = σ0 + d·w   with w = cof(S0) b.
+// Nine numbers per tet then give f, ∇f and ∇²f anywhere, with no vertex gathered and no matrix product:
+// a node's Newton steps and line search cost a few flops per tet of its star.
+struct StarTet {
+  double n0 = 0.0, beta = 0.0, sigma0 = 0.0;
+  Vector3d u = Vector3d::Zero(), w = Vector3d::Zero();
+  double delta = 0.0;  // the regularisation of σ for this update (Smoother::set_deltas)
+
+  double frobenius_squared(const Vector3d& d) const { return n0 + 2.0 * d.dot(u) + d.squaredNorm() * beta; }
+  double sigma(const Vector3d& d) const { return sigma0 + d.dot(w); }
+};
+
+StarTet star_tet(const Matrix3d& s, const Matrix3d& target_inverse, int k) {
+  const Vector3d b = k == 0 ? Vector3d(-target_inverse.colwise().sum().transpose()) : Vector3d(target_inverse.row(k - 1));
+  return {s.squaredNorm(), b.squaredNorm(), s.determinant(), s * b, cofactor(s) * b};
+}
+
+double distortion_at(const StarTet& tet, const Vector3d& d) {
+  return regularised_distortion(tet.frobenius_squared(d), tet.sigma(d), tet.delta);
+}
+
+// The exact distortion (δ = 0): infinite unless σ > 0.
+double exact_distortion_at(const StarTet& tet, const Vector3d& d) {
+  return regularised_distortion(tet.frobenius_squared(d), tet.sigma(d), 0.0);
+}
+
+// f, ∇f and ∇²f at d (no derivatives where f is infinite).
+Distortion distortion_derivatives(const StarTet& tet, const Vector3d& d) {
+  const double delta = tet.delta;
+  Distortion f;
+  const double n = tet.frobenius_squared(d);
+  const double sigma = tet.sigma(d);
+  f.value = regularised_distortion(n, sigma, delta);
+  if (!std::isfinite(f.value)) return f;
+  const double r = std::sqrt(sigma * sigma + 4.0 * delta * delta);
+  const Vector3d grad_n = 2.0 * (tet.u + tet.beta * d);
+  const Vector3d a = grad_n / n - (2.0 / 3.0) * tet.w / r;
+  f.gradient = f.value * a;
+  f.hessian = f.value * (a * a.transpose() + (2.0 * tet.beta / n) * Matrix3d::Identity() -
+                         grad_n * grad_n.transpose() / (n * n) +
+                         (2.0 / 3.0) * sigma / (r * r * r) * tet.w * tet.w.transpose());
+  return f;
+}
+
+// f^p, with the exponents SUS uses (1 while untangling, 4 after) spared a call to std::pow.
+double raise(double f, double power) {
+  if (power == 1.0) return f;
+  if (power == 4.0) return (f * f) * (f * f);
+  return std::pow(f, power);
+}
+
+// Adds f^p and its derivatives: ∇(f^p) = p f^(p-1) ∇f, ∇²(f^p) = p f^(p-1) ∇²f + p(p-1) f^(p-2) ∇f ∇fᵀ.
+void add_power(const Distortion& d, double power, Distortion& sum) {
+  if (power == 1.0) {
+    sum.value += d.value;
+    sum.gradient += d.gradient;
+    sum.hessian += d.hessian;
+    return;
+  }
+  const double f = d.value;
+  const double f_to_p = raise(f, power);
+  sum.value += f_to_p;
+  if (!std::isfinite(f)) return;
+  const double first = power * f_to_p / f;
+  sum.gradient += first * d.gradient;
+  sum.hessian += first * d.hessian + (power - 1.0) * first / f * d.gradient * d.gradient.transpose();
+}
+
+// The Newton direction -H⁻¹g in a node's parameters (j: dx/dparameters, whose zero columns are parameters
+// the node does not have), with H's eigenvalues made positive (|λ|, bounded away from 0) so that the
+// direction descends even where the objective is not convex. Where H is positive definite with no tiny
+// pivot that is plain Newton: a Cholesky solve gives it without the eigen-decomposition.
+Parameters descent_direction(Matrix3d h, const Parameters& g, const Jacobian& j) {
+  for (int i = 0; i < 3; ++i)
+    if (j.col(i).squaredNorm() == 0.0) h(i, i) = 1.0;  // an unused parameter: g_i = 0, so its step is 0
+  const Eigen::LLT<Matrix3d> cholesky(h);
+  if (cholesky.info() == Eigen::Success &&
+      cholesky.matrixLLT().diagonal().cwiseAbs2().minCoeff() >= 1e-8 * h.trace())
+    return -cholesky.solve(g);
+  const Eigen::SelfAdjointEigenSolver<Matrix3d> eigen(h);
+  Parameters magnitudes = eigen.eigenvalues().cwiseAbs();
+  const double floor = std::max(1e-8 * magnitudes.maxCoeff(), std::numeric_limits<double>::min());
+  magnitudes = magnitudes.cwiseMax(floor);
+  return -(eigen.eigenvectors() * (eigen.eigenvectors().transpose() * g).cwiseQuotient(magnitudes));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// How each node may move.
+
+enum class Freedom : std::uint8_t { fixed, space, box, surface, rim, crease };
+
+struct NodeFreedom {
+  Freedom kind = Freedom::space;
+  std::uint8_t free_axes = 7;  // box: bit i set if coordinate i may change
+  std::uint8_t rim_axis = 0;   // rim: the parameter (0 = u, 1 = v) that runs along its side of P
+  int surface = -1;            // surface, rim and crease: which projection, and the node's index in it
+  int index = -1;
+  const CreaseLine* crease = nullptr;  // crease: the line of P it moves along
+};
+
+// Where a node is: its position and, on a surface, its parameters and the triangle holding them (and on
+// a crease, its arc length along the line).
+struct Placement {
+  Vector3d x;
+  Vector2d uv = Vector2d::Zero();
+  int triangle = -1;
+  double arc = 0.0;
+};
+
+class Smoother {
+ public:
+  Smoother(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, const SmoothingOptions& options)
+      : mesh_(mesh), surfaces_(surfaces), options_(options), stars_(vertex_to_tets(mesh)) {
+    oriented_.resize(mesh.tets.size());
+#pragma omp parallel for schedule(static)
+    for (TetId t = 0; t < mesh.num_tets(); ++t) oriented_[t] = mesh.oriented_tet(t);
+    aim_at(options.target);
+    classify_nodes();
+  }
+
+  SmoothingStats run();
+  // `only`, if not empty, limits the nodes optimised to those it flags (per vertex).
+  ImprovementStats improve(const ImprovementOptions& options, std::span<const std::uint8_t> only = {});
+
+ private:
+  static Matrix3d equilateral_target() {
+    Matrix3d w;
+    w << 1.0, 0.5, 0.5, 0.0, std::sqrt(3.0) / 2.0, std::sqrt(3.0) / 6.0, 0.0, 0.0, std::sqrt(2.0 / 3.0);
+    return w;
+  }
+  // Sets every tet's W^-1 for `target`. The meccano's tets come in few shapes (the bisection's, level by
+  // level), so each W^-1 is kept once per shape, keyed by the tet's exact edge matrix in grid coordinates,
+  // and a tet holds the index of its own: a node's star then reads a small table that stays in cache
+  // instead of 72 bytes per tet from all over memory.
+  void aim_at(SmoothingTarget target) {
+    target_ = target;
+    target_inverses_.clear();
+    target_of_tet_.assign(mesh_.tets.size(), 0);
+    if (target == SmoothingTarget::equilateral) {
+      target_inverses_.push_back(equilateral_target().inverse());
+      return;
+    }
+    std::map<std::array<std::int64_t, 9>, std::uint32_t> shape_index;
+    // A remeshed tet has no meccano counterpart: the equilateral tet is its target.
+    std::optional<std::uint32_t> equilateral_shape;
+    for (TetId t = 0; t < mesh_.num_tets(); ++t) {
+      if (!mesh_.bisectable(t)) {
+        if (!equilateral_shape) {
+          equilateral_shape = static_cast<std::uint32_t>(target_inverses_.size());
+          target_inverses_.push_back(equilateral_target().inverse());
+        }
+        target_of_tet_[t] = *equilateral_shape;
+        continue;
+      }
+      const auto& v = oriented_[t];
+      std::array<std::int64_t, 9> edges;
+      for (int k = 0; k < 3; ++k)
+        for (int axis = 0; axis < 3; ++axis) edges[3 * k + axis] = mesh_.grid[v[k + 1]][axis] - mesh_.grid[v[0]][axis];
+      const auto [shape, added] = shape_index.try_emplace(edges, static_cast<std::uint32_t>(target_inverses_.size()));
+      if (added) {
+        Matrix3d w;
+        for (int k = 0; k < 3; ++k)
+          for (int axis = 0; axis < 3; ++axis)
+            w(axis, k) = mesh_.meccano.cell_size[axis] * static_cast<double>(edges[3 * k + axis]) / static_cast<double>(grid_cell);
+        target_inverses_.push_back(w.inverse());
+      }
+      target_of_tet_[t] = shape->second;
+    }
+  }
+  const Matrix3d& target_inverse(TetId t) const { return target_inverses_[target_of_tet_[t]]; }
+
+  void classify_nodes();
+  std::vector<VertexId> free_nodes() const;
+  std::vector<std::vector<VertexId>> colour(const std::vector<VertexId>& nodes) const;
+  template <class Visit>
+  void for_each_star_vertex(VertexId v, Visit&& visit) const {
+    for (TetId t : stars_.of(v))
+      for (VertexId w : oriented_[t])
+        if (w != v) visit(w);
+  }
+
+  // A, the edge matrix of tet t at the current positions, and S = A W^-1.
+  Matrix3d physical_edges(TetId t) const {
+    const auto& v = oriented_[t];
+    return edge_matrix({mesh_.points[v[0]], mesh_.points[v[1]], mesh_.points[v[2]], mesh_.points[v[3]]});
+  }
+  Matrix3d s_matrix(TetId t) const { return physical_edges(t) * target_inverse(t); }
+  // A node's star at its current position, and its mean edge length at the node (the scale of a
+  // sensible step).
+  struct Star {
+    std::span<StarTet> tets;
+    double mean_edge = 0.0;
+    std::span<StarTet> guard;  // improving: the same tets against the meccano target (exact, δ = 0)
+  };
+  Star take_star(VertexId v) const;
+  double star_objective(std::span<const StarTet> star, const Vector3d& d) const;
+  Distortion star_derivatives(std::span<const StarTet> star, const Vector3d& d) const;
+  bool set_deltas(std::span<StarTet> star) const;
+
+  Placement placement(VertexId v) const;
+  Jacobian jacobian(VertexId v, const Placement& at) const;
+  bool move(VertexId v, const Placement& from, const Parameters& step, Placement& to) const;
+  bool keeps_surface_embedded(const NodeFreedom& node, const Vector2d& uv) const;
+  bool optimise(VertexId v);
+  void store(VertexId v, const Placement& at);
+  SweepRecord measure() const;
+  // The exponent p of Σ η*^p: the paper's 1 while tangled, options_.power once a sweep ends untangled;
+  // the improvement's own.
+  double power() const { return improving_ ? improving_->power : tangled_ ? 1.0 : options_.power; }
+
+  TetMesh& mesh_;
+  std::span<SurfaceProjection* const> surfaces_;
+  SmoothingOptions options_;
+  VertexTets stars_;
+  std::vector<std::array<VertexId, 4>> oriented_;
+  SmoothingTarget target_ = SmoothingTarget::meccano;  // what the W^-1 are for now
+  std::vector<Matrix3d> target_inverses_;  // one per shape of tet
+  std::vector<std::uint32_t> target_of_tet_;
+  bool returned_from_fallback_ = false;  // did the smoothing aim at the meccano target again after the fallback?
+  std::vector<NodeFreedom> freedom_;
+  std::vector<std::vector<int>> hints_;  // per surface and node: the triangle of φ^-1(S) last holding it
+  std::vector<std::vector<int>> triangle_start_, node_triangles_;  // per surface: node -> S_M triangles (CSR)
+  std::vector<TetId> active_tets_;
+  SmoothingStats stats_;
+  bool tangled_ = true;               // did the last sweep end with inverted tets (or none ran yet)?
+  static constexpr double initial_untangling_epsilon = 1e-3;
+  double untangling_epsilon_ = initial_untangling_epsilon;  // ε / mean|σ|, raised while untangling stalls
+  const ImprovementOptions* improving_ = nullptr;  // set while improve() runs
+  std::vector<Matrix3d> guard_inverses_;            // improving: the meccano target's W^-1, per shape
+  std::vector<std::uint32_t> guard_of_tet_;
+};
+
+void Smoother::classify_nodes() {
+  const GridPoint upper = mesh_.meccano.upper_corner();
+  freedom_.assign(mesh_.points.size(), {});
+  for (VertexId v = 0; v < mesh_.num_vertices(); ++v) {
+    NodeFreedom& node = freedom_[v];
+    for (int axis = 0; axis < 3; ++axis)
+      if (mesh_.grid[v][axis] == 0 || mesh_.grid[v][axis] == upper[axis]) node.free_axes &= static_cast<std::uint8_t>(~(1u << axis));
+    if (node.free_axes == 0) node.kind = Freedom::fixed;
+    else if (node.free_axes != 7) node.kind = Freedom::box;
+  }
+  hints_.resize(surfaces_.size());
+  triangle_start_.resize(surfaces_.size());
+  node_triangles_.resize(surfaces_.size());
+  for (int s = 0; s < static_cast<int>(surfaces_.size()); ++s) {
+    const SurfaceProjection& projection = *surfaces_[s];
+    hints_[s].assign(projection.nodes.size(), -1);
+    std::vector<int>& start = triangle_start_[s];
+    start.assign(projection.nodes.size() + 1, 0);
+    for (const auto& triangle : projection.triangles)
+      for (int i : triangle) ++start[i + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    node_triangles_[s].resize(start.back());
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (int t = 0; t < static_cast<int>(projection.triangles.size()); ++t)
+      for (int i : projection.triangles[t]) node_triangles_[s][fill[i]++] = t;
+    for (int i = 0; i < static_cast<int>(projection.nodes.size()); ++i) {
+      NodeFreedom& node = freedom_[projection.nodes[i]];
+      if (node.kind != Freedom::space) {  // on the box or on another surface: cannot follow both
+        node.kind = Freedom::fixed;
+        continue;
+      }
+      node.surface = s;
+      node.index = i;
+      node.kind = Freedom::surface;
+      if (const int line = projection.creases.line_of[i]; line >= 0) {
+        node.kind = Freedom::crease;
+        node.crease = &projection.creases.lines[line];
+        continue;
+      }
+      if (!projection.on_rim[i]) continue;
+      // Rim parameters lie exactly on the square's sides; a corner of P lies on two and stays fixed.
+      const Vector2d& uv = projection.uv[i];
+      const bool u_on_side = uv.x() == 0.0 || uv.x() == 1.0;
+      const bool v_on_side = uv.y() == 0.0 || uv.y() == 1.0;
+      node.kind = u_on_side && v_on_side ? Freedom::fixed : Freedom::rim;
+      node.rim_axis = u_on_side ? 1 : 0;
+    }
+  }
+}
+
+std::vector<VertexId> Smoother::free_nodes() const {
+  std::vector<std::uint8_t> wanted(mesh_.points.size(), options_.mode == SmoothingMode::whole_mesh);
+  if (options_.mode == SmoothingMode::band) {
+    std::vector<VertexId> ring;
+    for (const SurfaceProjection* projection : surfaces_)
+      for (VertexId v : projection->nodes) {
+        wanted[v] = 1;
+        ring.push_back(v);
+      }
+    for (int step = 0; step < options_.band_rings; ++step) {
+      std::vector<VertexId> next;
+      for (VertexId v : ring)
+        for_each_star_vertex(v, [&](VertexId w) {
+          if (!wanted[w]) {
+            wanted[w] = 1;
+            next.push_back(w);
+          }
+        });
+      ring = std::move(next);
+    }
+  }
+  std::vector<VertexId> nodes;
+  for (VertexId v = 0; v < mesh_.num_vertices(); ++v)
+    if (wanted[v] && freedom_[v].kind != Freedom::fixed) nodes.push_back(v);
+  return nodes;
+}
+
+// Greedy colouring in node order: deterministic, and about as many colours as a node has neighbours.
+std::vector<std::vector<VertexId>> Smoother::colour(const std::vector<VertexId>& nodes) const {
+  std::vector<int> colour_of(mesh_.points.size(), -1);
+  std::vector<std::vector<VertexId>> colours;
+  std::vector<std::uint8_t> taken;
+  for (VertexId v : nodes) {
+    taken.assign(colours.size() + 1, 0);
+    for_each_star_vertex(v, [&](VertexId w) {
+      if (colour_of[w] >= 0) taken[colour_of[w]] = 1;
+    });
+    const int c = static_cast<int>(std::find(taken.begin(), taken.end(), 0) - taken.begin());
+    if (c == static_cast<int>(colours.size())) colours.emplace_back();
+    colours[c].push_back(v);
+    colour_of[v] = c;
+  }
+  return colours;
+}
+
+// The star of v at its current position, in a buffer of the calling thread (nodes are optimised in
+// parallel); valid until the thread takes the next star.
+Smoother::Star Smoother::take_star(VertexId v) const {
+  thread_local std::vector<StarTet> tets, guard;
+  tets.clear();
+  guard.clear();
+  double edges = 0.0;
+  int count = 0;
+  for (TetId t : stars_.of(v)) {
+    int local = 0;
+    for (int i = 0; i < 4; ++i) {
+      const VertexId w = oriented_[t][i];
+      if (w == v) {
+        local = i;
+      } else {
+        edges += (mesh_.points[w] - mesh_.points[v]).norm();
+        ++count;
+      }
+    }
+    const Matrix3d a = physical_edges(t);
+    tets.push_back(star_tet(a * target_inverse(t), target_inverse(t), local));
+    if (improving_) {
+      const Matrix3d& meccano = guard_inverses_[guard_of_tet_[t]];
+      guard.push_back(star_tet(a * meccano, meccano, local));
+    }
+  }
+  return {tets, edges / std::max(count, 1), guard};
+}
+
+double Smoother::star_objective(std::span<const StarTet> star, const Vector3d& d) const {
+  double value = 0.0;
+  for (const StarTet& tet : star) value += raise(distortion_at(tet, d), power());
+  return value;
+}
+
+Distortion Smoother::star_derivatives(std::span<const StarTet> star, const Vector3d& d) const {
+  Distortion sum;
+  for (const StarTet& tet : star) add_power(distortion_derivatives(tet, d), power(), sum);
+  return sum;
+}
+
+// Each tet's δ for the node's update, and whether the star holds an inverted tet.
+// SUS: one δ per star, Escobar et al.'s rule δ = √(ε(ε − σ_min)) when σ_min < ε, with the authors' floor
+// 1e-4 · mean|σ| (their code never lets δ reach 0). Their ε (2.2e-10 on a mesh scaled to radius 10) left
+// the cube example with 5 tets inverted after 100 sweeps: each sat in a local minimum behind S.
+// ε = 1e-3 · mean|σ| smooths the objective where the star is tangled and untangled it in 4 sweeps; on
+// valid stars δ is the floor, so the smoothing itself is unchanged.
+// Improvement: the star's floor exceeds the σ of tets far smaller than their neighbours, whose cost then
+// falls with their size (N / 3δ^(2/3)) however flat they are; so each tet's floor is 1e-4 of the σ of an
+// ideal tet of its own size, (‖S‖²/3)^(3/2), and small tets are seen as well as large ones.
+bool Smoother::set_deltas(std::span<StarTet> star) const {
+  double sigma_min = infinity, sigma_sum = 0.0;
+  for (const StarTet& tet : star) {
+    sigma_min = std::min(sigma_min, tet.sigma0);
+    sigma_sum += std::abs(tet.sigma0);
+  }
+  const bool tangled = sigma_min <= 0.0;
+  if (improving_) {
+    for (StarTet& tet : star) tet.delta = 1e-4 * tet.n0 / 3.0 * std::sqrt(tet.n0 / 3.0);
+    return tangled;
+  }
+  const double scale = sigma_sum / static_cast<double>(std::max<std::size_t>(star.size(), 1));
+  // The raised ε is for tangled stars only: on a valid star it would soften the barrier that keeps it
+  // valid, and untangling elsewhere would tangle it.
+  const double epsilon = (tangled ? untangling_epsilon_ : initial_untangling_epsilon) * scale;
+  const double untangling = sigma_min < epsilon ? std::sqrt(epsilon * (epsilon - sigma_min)) : 0.0;
+  const double delta = std::max(untangling, 1e-4 * scale);
+  for (StarTet& tet : star) tet.delta = delta;
+  return tangled;
+}
+
+Placement Smoother::placement(VertexId v) const {
+  Placement at{mesh_.points[v]};
+  const NodeFreedom& node = freedom_[v];
+  if (node.surface >= 0) {
+    at.uv = surfaces_[node.surface]->uv[node.index];
+    at.triangle = surfaces_[node.surface]->surface->locate(at.uv, hints_[node.surface][node.index]).triangle;
+    if (node.kind == Freedom::crease) at.arc = surfaces_[node.surface]->creases.parameter[node.index];
+  }
+  return at;
+}
+
+// dx/d(parameters) at a placement.
+Jacobian Smoother::jacobian(VertexId v, const Placement& at) const {
+  const NodeFreedom& node = freedom_[v];
+  Jacobian j = Jacobian::Zero();
+  switch (node.kind) {
+    case Freedom::space:
+      return Jacobian::Identity();
+    case Freedom::box:
+      for (int axis = 0, column = 0; axis < 3; ++axis)
+        if (node.free_axes & (1u << axis)) j(axis, column++) = 1.0;
+      break;
+    case Freedom::surface:
+      j.leftCols<2>() = surfaces_[node.surface]->surface->derivative(at.triangle);
+      break;
+    case Freedom::rim:
+      j.col(0) = surfaces_[node.surface]->surface->derivative(at.triangle).col(node.rim_axis);
+      break;
+    case Freedom::crease:
+      // φ is continuous across the crease edge and affine along it: either triangle gives this column.
+      j.col(0) = surfaces_[node.surface]->surface->derivative(at.triangle) * node.crease->direction(at.arc);
+      break;
+    case Freedom::fixed:
+      break;
+  }
+  return j;
+}
+
+// The placement after a step in the node's parameters; false if it would leave the node's domain
+// (the box, or the open square P for surface parameters: reaching P's boundary would put the node on
+// the rim of S).
+bool Smoother::move(VertexId v, const Placement& from, const Parameters& step, Placement& to) const {
+  const NodeFreedom& node = freedom_[v];
+  to = from;
+  switch (node.kind) {
+    case Freedom::space:
+      to.x += step;
+      return true;
+    case Freedom::box: {
+      const Box& box = mesh_.meccano.box;
+      for (int axis = 0, column = 0; axis < 3; ++axis)
+        if (node.free_axes & (1u << axis)) {
+          to.x[axis] += step[column++];
+          if (!(to.x[axis] > box.min[axis] && to.x[axis] < box.max[axis])) return false;
+        }
+      return true;
+    }
+    case Freedom::surface:
+      to.uv += step.head<2>();
+      if (!((to.uv.array() > 0.0).all() && (to.uv.array() < 1.0).all())) return false;
+      break;
+    case Freedom::rim:
+      to.uv[node.rim_axis] += step[0];
+      if (!(to.uv[node.rim_axis] > 0.0 && to.uv[node.rim_axis] < 1.0)) return false;
+      break;
+    case Freedom::crease:
+      // Strictly inside the line: its ends are where the crease fades or meets another one.
+      to.arc += step[0];
+      if (!(to.arc > 0.0 && to.arc < node.crease->length())) return false;
+      to.uv = node.crease->at(to.arc);
+      break;
+    case Freedom::fixed:
+      return false;
+  }
+  if (!keeps_surface_embedded(node, to.uv)) return false;
+  const ParametricSurface& surface = *surfaces_[node.surface]->surface;
+  const auto location = surface.locate(to.uv, from.triangle);
+  to.triangle = location.triangle;
+  to.x = surface.evaluate(location);
+  return true;
+}
+
+// Whether S_M's triangles around a surface node keep their orientation in P with the node at uv. The
+// tets alone do not guarantee it: S_M's triangles are chords of a curved S, and a triangle can fold in P
+// while both its tets stay valid; the fold then locks its neighbours in place.
+bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& uv) const {
+  const SurfaceProjection& projection = *surfaces_[node.surface];
+  const auto& start = triangle_start_[node.surface];
+  for (int k = start[node.index]; k < start[node.index + 1]; ++k)
+    if (!keeps_orientation(projection, projection.triangles[node_triangles_[node.surface][k]], node.index, uv)) return false;
+  return true;
+}
+
+// A few safeguarded Newton steps on the node's star. The new position is kept however small the move.
+// Any move of a node whose star was tangled counts (its neighbours get another look next sweep):
+// untangling creeps. Elsewhere only a move beyond 1 % of the star's edge length counts, so sweeps stop
+// revisiting regions that have settled, also while a few tets elsewhere are still being untangled
+// (revisiting every node then made the last untangling sweeps cost as much as the first: twice the
+// seconds per tet on faults whose last inverted tets took 20 sweeps).
+bool Smoother::optimise(VertexId v) {
+  const auto [star, length, guard] = take_star(v);
+  const bool tangled_star = set_deltas(star);
+  const Placement start = placement(v);
+  Placement at = start;
+  Distortion model = star_derivatives(star, Vector3d::Zero());
+  // Improving: the star's worst exact distortion towards the equilateral tet, which no step may raise,
+  // and towards the meccano targets, which may rise only up to 1 / threshold (so a star's meccano minimum
+  // either stays or stays above the threshold, and the mesh's meccano minimum cannot fall below
+  // min(before, threshold): the paper's measure is not traded away where it is already poor).
+  auto worst = [](std::span<const StarTet> tets, const Vector3d& d) {
+    double largest = 0.0;
+    for (const StarTet& tet : tets) largest = std::max(largest, exact_distortion_at(tet, d));
+    return largest;
+  };
+  double worst_at = improving_ ? worst(star, Vector3d::Zero()) : 0.0;
+  double guard_at = improving_ ? std::max(worst(guard, Vector3d::Zero()), 1.0 / improving_->threshold) : 0.0;
+  const int steps = improving_ ? improving_->newton_steps : tangled_ ? 2 * options_.newton_steps : options_.newton_steps;
+  for (int step = 0; step < steps; ++step) {
+    const double value = model.value;
+    const Jacobian j = jacobian(v, at);
+    const Parameters g = j.transpose() * model.gradient;
+    if (!std::isfinite(value) || g.norm() * length <= 1e-12 * value) break;
+    Parameters direction = descent_direction(j.transpose() * model.hessian * j, g, j);
+    // At most half the star's edge length per step: the quadratic model means little beyond that.
+    const double physical = (j * direction).norm();
+    if (physical > 0.5 * length) direction *= 0.5 * length / physical;
+    const double slope = g.dot(direction);
+    // The line search evaluates the derivatives too, except after the last step: the next step needs them
+    // where the trial is accepted, and the first trial (the Newton step) mostly is.
+    const bool last = step + 1 == steps;
+    Placement trial;
+    Distortion at_trial;
+    bool accepted = false;
+    double worst_trial = 0.0, guard_trial = 0.0;
+    for (double alpha = 1.0; alpha > 1e-6 && !accepted; alpha *= 0.5) {
+      if (!move(v, at, alpha * direction, trial)) continue;
+      const Vector3d d = trial.x - start.x;
+      at_trial = last ? Distortion{star_objective(star, d)} : star_derivatives(star, d);
+      accepted = at_trial.value <= value + 1e-4 * alpha * slope;
+      if (accepted && improving_)
+        accepted = (worst_trial = worst(star, d)) <= worst_at && (guard_trial = worst(guard, d)) <= guard_at;
+    }
+    if (!accepted) break;
+    const double moved = (trial.x - at.x).norm();
+    at = trial;
+    model = at_trial;
+    if (improving_) {
+      worst_at = worst_trial;
+      guard_at = std::max(guard_trial, 1.0 / improving_->threshold);
+    }
+    if (moved <= 1e-9 * length) break;
+  }
+  const double moved = (at.x - start.x).norm();
+  if (moved == 0.0) return false;
+  store(v, at);
+  return tangled_star || moved > 1e-2 * length;
+}
+
+void Smoother::store(VertexId v, const Placement& at) {
+  mesh_.points[v] = at.x;
+  const NodeFreedom& node = freedom_[v];
+  if (node.surface >= 0) {
+    surfaces_[node.surface]->uv[node.index] = at.uv;
+    hints_[node.surface][node.index] = at.triangle;
+    if (node.kind == Freedom::crease) surfaces_[node.surface]->creases.parameter[node.index] = at.arc;
+  }
+}
+
+// Inverted tets and the target quality over the active tets (per-tet values first, then a serial sum, so
+// the result does not depend on the thread count).
+SweepRecord Smoother::measure() const {
+  std::vector<double> distortion(active_tets_.size());
+  const auto count = static_cast<std::int64_t>(active_tets_.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < count; ++i) {
+    const TetId t = active_tets_[i];
+    const Matrix3d s = s_matrix(t);
+    const double sigma = s.determinant();
+    distortion[i] = sigma > 0.0 ? s.squaredNorm() / (3.0 * std::cbrt(sigma * sigma)) : infinity;
+  }
+  SweepRecord record;
+  record.min_quality = 1.0;
+  for (double eta : distortion) {
+    const double q = std::isfinite(eta) ? 1.0 / eta : 0.0;
+    record.inverted += q == 0.0;
+    record.min_quality = std::min(record.min_quality, q);
+    record.mean_quality += q;
+    record.objective += raise(eta, power());
+  }
+  if (count > 0) record.mean_quality /= static_cast<double>(count);
+  return record;
+}
+
+SmoothingStats Smoother::run() {
+  const std::vector<VertexId> nodes = free_nodes();
+  for (VertexId v : nodes) {
+    switch (freedom_[v].kind) {
+      case Freedom::space: ++stats_.inner_nodes; break;
+      case Freedom::box: ++stats_.box_nodes; break;
+      case Freedom::surface: ++stats_.surface_nodes; break;
+      case Freedom::rim: ++stats_.rim_nodes; break;
+      case Freedom::crease: ++stats_.crease_nodes; break;
+      case Freedom::fixed: break;
+    }
+  }
+  std::vector<std::uint8_t> active(mesh_.tets.size(), 0);
+  for (VertexId v : nodes)
+    for (TetId t : stars_.of(v)) active[t] = 1;
+  for (TetId t = 0; t < mesh_.num_tets(); ++t)
+    if (active[t]) active_tets_.push_back(t);
+  stats_.active_tets = static_cast<std::int64_t>(active_tets_.size());
+  stats_.inverted_before = count_inverted(mesh_);
+
+  const auto colours = colour(nodes);
+  stats_.colours = static_cast<int>(colours.size());
+  // A node needs another look only if it or a node of its star moved since it was last optimised.
+  std::vector<std::int64_t> last_moved(mesh_.points.size(), 0), last_optimised(mesh_.points.size(), -1);
+  std::int64_t epoch = 0;
+  int clean_sweeps = 0;
+  std::int64_t fewest_inverted = std::numeric_limits<std::int64_t>::max();
+  int stalled_sweeps = 0;     // since ε was last raised or the fewest inverted count lowered
+  int sweeps_since_fewest = 0;
+  // A new target changes every node's objective: all of them get another look.
+  auto switch_target = [&](SmoothingTarget target) {
+    aim_at(target);
+    std::fill(last_optimised.begin(), last_optimised.end(), -1);
+  };
+  for (int sweep = 1; sweep <= options_.max_sweeps; ++sweep) {
+    if (tangled_ && target_ == SmoothingTarget::meccano && options_.fallback_sweeps > 0 &&
+        (sweep > options_.fallback_sweeps || returned_from_fallback_)) {
+      // Untangling towards the meccano target stalled (or its smoothing tangled the mesh again).
+      switch_target(SmoothingTarget::equilateral);
+      if (stats_.fallback_sweep == 0) stats_.fallback_sweep = sweep;
+      untangling_epsilon_ = initial_untangling_epsilon;
+      fewest_inverted = std::numeric_limits<std::int64_t>::max();
+      stalled_sweeps = sweeps_since_fewest = 0;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    std::int64_t optimised = 0;
+    for (const auto& group : colours) {
+      ++epoch;
+      const auto size = static_cast<std::int64_t>(group.size());
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : optimised)
+      for (std::int64_t i = 0; i < size; ++i) {
+        const VertexId v = group[i];
+        std::int64_t latest = last_moved[v];
+        for_each_star_vertex(v, [&](VertexId w) { latest = std::max(latest, last_moved[w]); });
+        if (latest < last_optimised[v]) continue;
+        last_optimised[v] = epoch;
+        ++optimised;
+        if (optimise(v)) last_moved[v] = epoch;
+      }
+    }
+    SweepRecord record = measure();
+    record.nodes_optimised = optimised;
+    record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    record.power = power();
+    record.target = target_;
+    // The objective can only be compared with the previous sweep's if both used the same power and W.
+    const bool comparable = !stats_.sweeps.empty() && stats_.sweeps.back().power == power() &&
+                            stats_.sweeps.back().target == target_ && stats_.sweeps.back().inverted == 0;
+    const double previous_objective = comparable ? stats_.sweeps.back().objective : infinity;
+    stats_.sweeps.push_back(record);
+    if (options_.on_sweep) options_.on_sweep(sweep, record);
+    // Untangling uses the paper's sum; once a sweep ends untangled, the next ones weigh bad tets more.
+    tangled_ = record.inverted > 0;
+    if (record.inverted > 0) {
+      // Stalled untangling: the tangled stars sit in local minima of a steep objective. A larger ε
+      // (a larger δ where stars are tangled) flattens it so that nodes can pass through.
+      if (record.inverted < fewest_inverted) {
+        fewest_inverted = record.inverted;
+        stalled_sweeps = sweeps_since_fewest = 0;
+      } else if (++stalled_sweeps >= 3 && untangling_epsilon_ < 1.0) {
+        untangling_epsilon_ *= 10.0;
+        stalled_sweeps = 0;
+      }
+      const bool fallback_pending =
+          target_ == SmoothingTarget::meccano && options_.fallback_sweeps > 0 && stats_.fallback_sweep == 0;
+      if (++sweeps_since_fewest > options_.stalled_sweeps && !fallback_pending) break;  // stuck: give up
+      continue;
+    }
+    // A raised ε would keep δ large on valid stars, and their barrier soft: smoothing could tangle again.
+    untangling_epsilon_ = initial_untangling_epsilon;
+    // The objective's power changes with the first untangled sweep: every node gets another look.
+    if (clean_sweeps == 0) std::fill(last_optimised.begin(), last_optimised.end(), -1);
+    if (clean_sweeps++ == 0 && stats_.inverted_before > 0) stats_.untangling_sweeps = sweep;
+    if (clean_sweeps >= options_.smoothing_sweeps || optimised == 0) break;
+    if (target_ != options_.target && !returned_from_fallback_) {
+      switch_target(options_.target);  // untangled by the fallback: smooth towards the chosen target
+      returned_from_fallback_ = true;
+      continue;
+    }
+    if (comparable && previous_objective - record.objective <= options_.tolerance * previous_objective) break;
+  }
+  stats_.inverted_after = count_inverted(mesh_);
+  return stats_;
+}
+
+ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<const std::uint8_t> only) {
+  improving_ = &options;
+  tangled_ = false;
+  aim_at(SmoothingTarget::meccano);
+  guard_inverses_ = std::move(target_inverses_);
+  guard_of_tet_ = std::move(target_of_tet_);
+  aim_at(SmoothingTarget::equilateral);
+  ImprovementStats stats;
+  std::vector<double> quality(mesh_.tets.size());
+  std::vector<std::uint8_t> movable(mesh_.points.size(), 0);
+  for (VertexId v : free_nodes()) movable[v] = only.empty() || only[v];
+  // The equilateral mean ratio of the given tets (those whose nodes may have moved).
+  auto measure_tets = [&](const std::vector<TetId>& tets) {
+    const auto count = static_cast<std::int64_t>(tets.size());
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < count; ++i) quality[tets[i]] = mean_ratio_equilateral(oriented_points(mesh_, tets[i]));
+  };
+  // The worst tets' movable nodes, in vertex order.
+  auto worst_nodes = [&] {
+    std::vector<VertexId> nodes;
+    for (TetId t = 0; t < mesh_.num_tets(); ++t)
+      if (quality[t] < options.threshold)
+        for (VertexId v : mesh_.tets[t])
+          if (movable[v]) nodes.push_back(v);
+    std::sort(nodes.begin(), nodes.end());
+    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    return nodes;
+  };
+  auto below_threshold = [&] {
+    return static_cast<std::int64_t>(std::count_if(quality.begin(), quality.end(), [&](double q) { return q < options.threshold; }));
+  };
+  std::vector<TetId> all(mesh_.tets.size());
+  std::iota(all.begin(), all.end(), TetId{0});
+  measure_tets(all);
+  std::vector<VertexId> nodes = worst_nodes();
+  stats.tets_below_before = below_threshold();
+  stats.min_quality_before = quality.empty() ? 0.0 : *std::min_element(quality.begin(), quality.end());
+  while (!nodes.empty() && stats.passes < options.max_passes) {
+    ++stats.passes;
+    std::int64_t moved = 0;
+    for (const auto& group : colour(nodes)) {
+      const auto size = static_cast<std::int64_t>(group.size());
+#pragma omp parallel for schedule(dynamic, 16) reduction(+ : moved)
+      for (std::int64_t i = 0; i < size; ++i) moved += optimise(group[i]);
+    }
+    const std::size_t tried = nodes.size();
+    stats.node_updates += static_cast<std::int64_t>(tried);
+    stats.nodes_moved += moved;
+    std::vector<TetId> touched;
+    for (VertexId v : nodes) touched.insert(touched.end(), stars_.of(v).begin(), stars_.of(v).end());
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    measure_tets(touched);
+    nodes = worst_nodes();
+    if (options.progress)
+      options.progress("improvement pass " + std::to_string(stats.passes) + ": " + std::to_string(moved) + " of " +
+                       std::to_string(tried) + " nodes moved; " + std::to_string(below_threshold()) +
+                       " tets below the threshold, smallest quality " +
+                       std::to_string(*std::min_element(quality.begin(), quality.end())));
+    if (moved == 0) break;
+  }
+  stats.tets_below_after = below_threshold();
+  stats.min_quality_after = quality.empty() ? 0.0 : *std::min_element(quality.begin(), quality.end());
+  improving_ = nullptr;
+  return stats;
+}
+
+}  // namespace
+
+Distortion regularised_distortion(const TetPoints& physical, const Matrix3d& target_inverse, int vertex,
+                                  double delta) {
+  StarTet tet = star_tet(edge_matrix(physical) * target_inverse, target_inverse, vertex);
+  tet.delta = delta;
+  return distortion_derivatives(tet, Vector3d::Zero());
+}
+
+SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, const SmoothingOptions& options) {
+  return Smoother(mesh, surfaces, options).run();
+}
+
+ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
+                                    const ImprovementOptions& options, const SmoothingOptions& sus,
+                                    std::span<TetRegion* const> regions) {
+  // improve() sets both targets; SUS's mode and band decide which nodes are free. A flip changes the
+  // stars, so each round smooths with a Smoother built afresh.
+  auto smooth = [&](std::span<const std::uint8_t> only) {
+    return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})
+        .improve(options, only);
+  };
+  const FlipStats mends = options.topology ? conform_to_creases(mesh, surfaces, regions, options) : FlipStats{};
+  if (options.topology && options.progress) options.progress("improvement creases: " + describe(mends));
+  ImprovementStats stats = smooth({});
+  stats.flips += mends;
+  if (!options.topology) return stats;
+  for (int round = 0; round < options.rounds; ++round) {
+    const FlipStats flips = flip_worst_tets(mesh, surfaces, regions, options);
+    if (flips.operations() == 0) break;
+    ++stats.rounds;
+    stats.flips += flips;
+    // Elsewhere the nodes and their stars are as the last smoothing left them, which would do the same
+    // again: only the nodes of flipped tets are optimised.
+    std::vector<std::uint8_t> flipped(mesh.points.size(), 0);
+    for (TetId t = 0; t < mesh.num_tets(); ++t)
+      if (!mesh.bisectable(t))
+        for (VertexId v : mesh.tets[t]) flipped[v] = 1;
+    const ImprovementStats smoothed = smooth(flipped);
+    stats.passes += smoothed.passes;
+    stats.node_updates += smoothed.node_updates;
+    stats.nodes_moved += smoothed.nodes_moved;
+    stats.tets_below_after = smoothed.tets_below_after;
+    stats.min_quality_after = smoothed.min_quality_after;
+  }
+  for (TetId t = 0; t < mesh.num_tets(); ++t) stats.remeshed_tets += !mesh.bisectable(t);
+  return stats;
+}
+
+}  // namespace meccano

@@ -1,25 +1,22 @@
 // Surface readers (OBJ, STL, OFF, Gmsh MSH, GOCAD TSurf), vertex welding and the parts of a surface.
 //
-// Every reader loads the whole file, parses it with FileCursor (text tokens with line numbers, or
-// binary values), and hands the raw points and triangles to finish_surface, which welds the
-// duplicated vertices, drops the triangles a deliberate weld collapsed, and drops the unused
-// vertices. Header counts are checked against the bytes left in the file before anything is
-// allocated from them, so a corrupt count yields an error instead of a bad_alloc.
+// Every reader loads the whole file, parses it with a ByteCursor (io/byte_cursor.hpp), and hands
+// the raw points and triangles to finish_surface, which welds the duplicated vertices, drops the
+// triangles a deliberate weld collapsed, and drops the unused vertices. Header counts are checked
+// against the bytes left in the file before anything is allocated from them, so a corrupt count
+// yields an error instead of a bad_alloc.
 #include <meccano/error.hpp>
 #include <meccano/io/surface_readers.hpp>
 
+#include "io/byte_cursor.hpp"
 #include "mesh/topology_helpers.hpp"
 
 #include <algorithm>
 #include <bit>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <optional>
 #include <set>
@@ -31,210 +28,16 @@
 namespace meccano {
 namespace {
 
+using readers::ByteCursor;
+using readers::iequals;
+using readers::quoted;
+using readers::read_file_bytes;
+using readers::Token;
 using Triangle = std::array<int, 3>;
 
 [[noreturn]] void fail_file(const std::string& path, const std::string& defect) {
   throw InputError(path + ": " + defect);
 }
-
-// A token for an error message: file contents may be binary garbage or a megabyte without spaces.
-std::string quoted(std::string_view text, std::size_t max_shown = 40) {
-  std::string shown;
-  for (const char ch : text.substr(0, max_shown)) {
-    const auto code = static_cast<unsigned char>(ch);
-    shown += (code < 0x20 || code == 0x7f) ? '?' : ch;
-  }
-  if (text.size() > max_shown) shown += "...";
-  return "'" + shown + "'";
-}
-
-bool iequals(std::string_view a, std::string_view b) {
-  return std::ranges::equal(a, b, [](char x, char y) {
-    return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
-  });
-}
-
-std::string read_file_bytes(const std::string& path) {
-  std::error_code ignored;
-  if (std::filesystem::is_directory(path, ignored)) fail_file(path, "cannot open file (it is a directory)");
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) fail_file(path, "cannot open file");
-  const std::streamoff size = in.tellg();
-  if (size < 0) fail_file(path, "cannot read file");
-  std::string bytes(static_cast<std::size_t>(size), '\0');
-  in.seekg(0);
-  if (!in.read(bytes.data(), size)) fail_file(path, "cannot read file");
-  if (bytes.empty()) fail_file(path, "empty file");
-  return bytes;
-}
-
-struct Token {
-  std::string_view text;
-  int line = 0;
-};
-
-// A read position in a file's bytes, shared by all readers: whitespace-separated text tokens (with
-// line numbers and optional comments running to the end of the line) and native or little-endian
-// binary values. Errors name the file and, until binary data has been read, the line.
-class FileCursor {
- public:
-  FileCursor(std::string path, std::string_view bytes, char comment = '\0')
-      : path_(std::move(path)), bytes_(bytes), comment_(comment) {}
-
-  const std::string& path() const { return path_; }
-  std::size_t remaining() const { return bytes_.size() - pos_; }
-
-  std::optional<Token> next_token() {
-    skip_blanks(/*cross_lines=*/true);
-    return token_here();
-  }
-  // No token when the current line has none left.
-  std::optional<Token> next_token_on_line() {
-    skip_blanks(/*cross_lines=*/false);
-    return token_here();
-  }
-  Token expect_token(std::string_view what) {
-    if (auto token = next_token()) return *token;
-    fail_at_end(what);
-  }
-  Token expect_token_on_line(std::string_view what) {
-    if (auto token = next_token_on_line()) return *token;
-    if (pos_ == bytes_.size()) fail_at_end(what);
-    fail("expected " + std::string(what) + " before the end of the line");
-  }
-  Token expect_keyword(std::string_view keyword) {
-    const Token token = expect_token("'" + std::string(keyword) + "'");
-    if (!iequals(token.text, keyword))
-      fail_at(token.line, "expected '" + std::string(keyword) + "', found " + quoted(token.text));
-    return token;
-  }
-  void skip_line() { rest_of_line(); }
-  // The raw rest of the current line (comments included), moving to the start of the next one.
-  std::string_view rest_of_line() {
-    const std::size_t end = bytes_.find('\n', pos_);
-    const std::string_view rest = bytes_.substr(pos_, end == std::string_view::npos ? end : end - pos_);
-    pos_ = end == std::string_view::npos ? bytes_.size() : end + 1;
-    if (end != std::string_view::npos) ++line_;
-    return rest;
-  }
-  // Moves just past the next occurrence of `marker`; false (and no move) when there is none.
-  bool skip_past(std::string_view marker) { return text_until(marker).has_value(); }
-  // The raw text up to the next occurrence of `marker`, moving just past it; none (and no move) when
-  // there is none.
-  std::optional<std::string_view> text_until(std::string_view marker) {
-    const std::size_t found = bytes_.find(marker, pos_);
-    if (found == std::string_view::npos) return std::nullopt;
-    const std::string_view text = bytes_.substr(pos_, found - pos_);
-    const std::size_t end = found + marker.size();
-    line_ += static_cast<int>(std::ranges::count(bytes_.substr(pos_, end - pos_), '\n'));
-    pos_ = end;
-    return text;
-  }
-
-  long long integer(const Token& token, std::string_view what) const {
-    const std::string_view text = without_plus(token.text);
-    long long value = 0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error == std::errc::invalid_argument || end != text.data() + text.size())
-      fail_at(token.line, "malformed " + std::string(what) + " " + quoted(token.text));
-    if (error == std::errc::result_out_of_range)
-      fail_at(token.line, std::string(what) + " " + quoted(token.text) + " is out of range");
-    return value;
-  }
-  double number(const Token& token, std::string_view what) const {
-    const std::string_view text = without_plus(token.text);
-    double value = 0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error == std::errc::invalid_argument || end != text.data() + text.size())
-      fail_at(token.line, "malformed " + std::string(what) + " " + quoted(token.text));
-    // from_chars leaves the value unset when out of range: overflow becomes infinite (and rejected
-    // by the callers that need finite values), underflow is as good as zero.
-    if (error == std::errc::result_out_of_range) value = std::strtod(std::string(text).c_str(), nullptr);
-    return value;
-  }
-  double coordinate(const Token& token) const {
-    const double value = number(token, "coordinate");
-    if (!std::isfinite(value)) fail_at(token.line, "non-finite coordinate " + quoted(token.text));
-    return value;
-  }
-
-  template <class T>
-  T binary(std::string_view what, std::endian order = std::endian::native) {
-    binary_seen_ = true;
-    if (remaining() < sizeof(T)) fail("unexpected end of file (reading " + std::string(what) + ")");
-    std::array<char, sizeof(T)> raw;
-    std::memcpy(raw.data(), bytes_.data() + pos_, sizeof(T));
-    if (order != std::endian::native) std::ranges::reverse(raw);
-    T value;
-    std::memcpy(&value, raw.data(), sizeof(T));
-    pos_ += sizeof(T);
-    return value;
-  }
-  void skip_bytes(std::uint64_t count, std::string_view what) {
-    binary_seen_ = true;
-    if (count > remaining()) fail("unexpected end of file (reading " + std::string(what) + ")");
-    pos_ += static_cast<std::size_t>(count);
-  }
-
-  // Refuses a header count whose items, at `min_bytes` each, cannot fit in the rest of the file.
-  void check_count(std::uint64_t count, std::uint64_t min_bytes, std::string_view what) const {
-    if (count > remaining() / min_bytes)
-      fail("absurd " + std::string(what) + " count " + std::to_string(count) + ": cannot fit in the " +
-           std::to_string(remaining()) + " bytes left in the file");
-  }
-
-  [[noreturn]] void fail(const std::string& defect) const { fail_at(line_, defect); }
-  // At the end of the file, the last line: the one a final newline ends, not the empty one after it.
-  [[noreturn]] void fail_at_end(std::string_view what) const {
-    const bool final_newline = !bytes_.empty() && bytes_.back() == '\n';
-    fail_at(final_newline ? line_ - 1 : line_, "unexpected end of file (expected " + std::string(what) + ")");
-  }
-  [[noreturn]] void fail_at(int line, const std::string& defect) const {
-    if (binary_seen_) fail_file(path_, defect);  // line numbers mean nothing after binary data
-    throw InputError(path_ + ":" + std::to_string(line) + ": " + defect);
-  }
-
- private:
-  // from_chars rejects a leading '+', which text formats allow.
-  static std::string_view without_plus(std::string_view text) {
-    if (text.size() > 1 && text[0] == '+' && text[1] != '-' && text[1] != '+') text.remove_prefix(1);
-    return text;
-  }
-  static bool is_blank(char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\f' || ch == '\v'; }
-
-  void skip_blanks(bool cross_lines) {
-    while (pos_ < bytes_.size()) {
-      const char ch = bytes_[pos_];
-      if (ch == '\n') {
-        if (!cross_lines) return;
-        ++line_;
-        ++pos_;
-      } else if (is_blank(ch)) {
-        ++pos_;
-      } else if (comment_ != '\0' && ch == comment_) {
-        const std::size_t end = bytes_.find('\n', pos_);
-        pos_ = end == std::string_view::npos ? bytes_.size() : end;
-      } else {
-        return;
-      }
-    }
-  }
-  std::optional<Token> token_here() {
-    if (pos_ == bytes_.size() || bytes_[pos_] == '\n') return std::nullopt;
-    const std::size_t begin = pos_;
-    while (pos_ < bytes_.size() && bytes_[pos_] != '\n' && !is_blank(bytes_[pos_]) &&
-           (comment_ == '\0' || bytes_[pos_] != comment_))
-      ++pos_;
-    return Token{bytes_.substr(begin, pos_ - begin), line_};
-  }
-
-  std::string path_;
-  std::string_view bytes_;
-  char comment_;
-  std::size_t pos_ = 0;
-  int line_ = 1;
-  bool binary_seen_ = false;
-};
 
 // Diagonal of the bounding box of the vertices that triangles use (an OBJ file may hold others).
 double used_bounding_box_diagonal(const TriangleSurface& surface) {
@@ -349,7 +152,7 @@ std::string index_range(long long first, long long count) {
 // ---------------------------------------------------------------------------------------------- OBJ
 
 TriangleSurface parse_obj(const std::string& path, std::string_view bytes, ReadContext& context) {
-  FileCursor cursor(path, bytes, '#');
+  ByteCursor cursor(path, bytes, '#');
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> triangles;
   std::vector<int> triangle_lines;  // positive indices may refer to later vertices: checked at the end
@@ -427,7 +230,7 @@ TriangleSurface parse_binary_stl(const std::string& path, std::string_view bytes
                                                  : " (unexpected data after the last triangle)"));
   if (count > std::numeric_limits<int>::max() / 3)
     fail_file(path, std::to_string(count) + " triangles: more than a surface can hold");
-  FileCursor cursor(path, bytes);
+  ByteCursor cursor(path, bytes);
   cursor.skip_bytes(kStlHeaderBytes, "header");
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> triangles;
@@ -449,7 +252,7 @@ TriangleSurface parse_binary_stl(const std::string& path, std::string_view bytes
 }
 
 TriangleSurface parse_ascii_stl(const std::string& path, std::string_view bytes, ReadContext& context) {
-  FileCursor cursor(path, bytes);
+  ByteCursor cursor(path, bytes);
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> triangles;
   cursor.expect_keyword("solid");
@@ -513,7 +316,7 @@ bool is_off_keyword(std::string_view text) {
 }
 
 TriangleSurface parse_off(const std::string& path, std::string_view bytes, ReadContext& context) {
-  FileCursor cursor(path, bytes, '#');
+  ByteCursor cursor(path, bytes, '#');
   const Token header = cursor.expect_token("'OFF' header");
   if (!is_off_keyword(header.text))
     cursor.fail_at(header.line, "expected the 'OFF' header, found " + quoted(header.text));
@@ -832,7 +635,7 @@ class MshReader {
                    std::to_string(count));
   }
 
-  FileCursor cursor_;
+  ByteCursor cursor_;
   bool binary_ = false;
   bool version4_ = false;
   std::vector<Eigen::Vector3d> points_;
@@ -1095,7 +898,7 @@ class TsurfReader {
             true};
   }
 
-  FileCursor cursor_;
+  ByteCursor cursor_;
   TsurfFile file_;
   std::vector<Eigen::Vector3d> points_;
   std::vector<Triangle> triangles_;

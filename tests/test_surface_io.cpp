@@ -581,7 +581,7 @@ TEST_F(SurfaceIo, MshDuplicateNodeTag) {
 
 TEST_F(SurfaceIo, MshNonFiniteCoordinate) {
   const std::string text = kMsh22Header + "$Nodes\n2\n1 0 0 0\n2 1 NaN 0\n$EndNodes\n";
-  EXPECT_THAT(read_error("nan.msh", text), HasSubstr("nan.msh:7: non-finite coordinate 'NaN'"));
+  EXPECT_THAT(read_error("nan.msh", text), HasSubstr("nan.msh:7: node 2 has a non-finite coordinate 'NaN'"));
 }
 
 TEST_F(SurfaceIo, MshAbsurdCounts) {

@@ -73,7 +73,8 @@ Token ByteCursor::expect_token_on_line(std::string_view what) {
 
 Token ByteCursor::expect_keyword(std::string_view keyword) {
   const Token token = expect_token(quoted(keyword));
-  if (!iequals(token.text, keyword)) fail_at(token.line, "expected " + quoted(keyword) + ", found " + quoted(token.text));
+  if (!iequals(token.text, keyword))
+    fail_at(token.line, "expected " + quoted(keyword) + ", found " + quoted(token.text));
   return token;
 }
 

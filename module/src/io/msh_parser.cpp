@@ -58,6 +58,7 @@ class MshParser {
   }
 
  private:
+  // A section's end marker: text, after its binary data if any.
   void expect(const std::string& keyword) {
     binary_data_ = false;
     const Token token = cursor_.expect_token("'" + keyword + "'");

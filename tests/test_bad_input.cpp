@@ -8,7 +8,7 @@
 // | truncated binary STL                   | "binary STL header announces 32 triangles", "truncated file" | SurfaceIo.StlTruncatedBinary                  |
 // | truncated binary / text MSH            | "byte N: ... truncated binary data", "unexpected end of file" | SurfaceIo.MshTruncatedBinary, Check.ReaderErrors... |
 // | absurd counts in headers               | "header announces 4294967295 triangles"              | SurfaceIo.StlAbsurdTriangleCount, OffAbsurdCounts,    |
-// |                                        | "announces N nodes, more than its remaining bytes"   | MshAbsurdCounts, Check.ReaderErrors...                |
+// |                                        | "absurd node count N: cannot fit in the B bytes"     | MshAbsurdCounts, Check.ReaderErrors...                |
 // | NaN coordinates                        | "non-finite coordinate"                              | SurfaceIo.ObjNonFiniteCoordinate, StlBinaryNonFinite- |
 // |                                        |                                                      | Coordinate, MshNonFiniteCoordinate; SurfaceTopology.  |
 // |                                        |                                                      | NonFiniteCoordinate; Check.ReaderErrors...            |

@@ -1,25 +1,23 @@
 // Surface readers (OBJ, STL, OFF, Gmsh MSH, GOCAD TSurf), vertex welding and the parts of a surface.
 //
-// Every reader loads the whole file, parses it with FileCursor (text tokens with line numbers, or
-// binary values), and hands the raw points and triangles to finish_surface, which welds the
-// duplicated vertices, drops the triangles a deliberate weld collapsed, and drops the unused
-// vertices. Header counts are checked against the bytes left in the file before anything is
-// allocated from them, so a corrupt count yields an error instead of a bad_alloc.
+// Every reader loads the whole file, parses it with a ByteCursor (io/byte_cursor.hpp), and hands
+// the raw points and triangles to finish_surface, which welds the duplicated vertices, drops the
+// triangles a deliberate weld collapsed, and drops the unused vertices. Header counts are checked
+// against the bytes left in the file before anything is allocated from them, so a corrupt count
+// yields an error instead of a bad_alloc.
 #include <meccano/error.hpp>
 #include <meccano/io/surface_readers.hpp>
 
+#include "io/byte_cursor.hpp"
+#include "io/msh_parser.hpp"
 #include "mesh/topology_helpers.hpp"
 
 #include <algorithm>
 #include <bit>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <optional>
 #include <set>
@@ -31,210 +29,16 @@
 namespace meccano {
 namespace {
 
+using readers::ByteCursor;
+using readers::iequals;
+using readers::quoted;
+using readers::read_file_bytes;
+using readers::Token;
 using Triangle = std::array<int, 3>;
 
 [[noreturn]] void fail_file(const std::string& path, const std::string& defect) {
   throw InputError(path + ": " + defect);
 }
-
-// A token for an error message: file contents may be binary garbage or a megabyte without spaces.
-std::string quoted(std::string_view text, std::size_t max_shown = 40) {
-  std::string shown;
-  for (const char ch : text.substr(0, max_shown)) {
-    const auto code = static_cast<unsigned char>(ch);
-    shown += (code < 0x20 || code == 0x7f) ? '?' : ch;
-  }
-  if (text.size() > max_shown) shown += "...";
-  return "'" + shown + "'";
-}
-
-bool iequals(std::string_view a, std::string_view b) {
-  return std::ranges::equal(a, b, [](char x, char y) {
-    return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
-  });
-}
-
-std::string read_file_bytes(const std::string& path) {
-  std::error_code ignored;
-  if (std::filesystem::is_directory(path, ignored)) fail_file(path, "cannot open file (it is a directory)");
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) fail_file(path, "cannot open file");
-  const std::streamoff size = in.tellg();
-  if (size < 0) fail_file(path, "cannot read file");
-  std::string bytes(static_cast<std::size_t>(size), '\0');
-  in.seekg(0);
-  if (!in.read(bytes.data(), size)) fail_file(path, "cannot read file");
-  if (bytes.empty()) fail_file(path, "empty file");
-  return bytes;
-}
-
-struct Token {
-  std::string_view text;
-  int line = 0;
-};
-
-// A read position in a file's bytes, shared by all readers: whitespace-separated text tokens (with
-// line numbers and optional comments running to the end of the line) and native or little-endian
-// binary values. Errors name the file and, until binary data has been read, the line.
-class FileCursor {
- public:
-  FileCursor(std::string path, std::string_view bytes, char comment = '\0')
-      : path_(std::move(path)), bytes_(bytes), comment_(comment) {}
-
-  const std::string& path() const { return path_; }
-  std::size_t remaining() const { return bytes_.size() - pos_; }
-
-  std::optional<Token> next_token() {
-    skip_blanks(/*cross_lines=*/true);
-    return token_here();
-  }
-  // No token when the current line has none left.
-  std::optional<Token> next_token_on_line() {
-    skip_blanks(/*cross_lines=*/false);
-    return token_here();
-  }
-  Token expect_token(std::string_view what) {
-    if (auto token = next_token()) return *token;
-    fail_at_end(what);
-  }
-  Token expect_token_on_line(std::string_view what) {
-    if (auto token = next_token_on_line()) return *token;
-    if (pos_ == bytes_.size()) fail_at_end(what);
-    fail("expected " + std::string(what) + " before the end of the line");
-  }
-  Token expect_keyword(std::string_view keyword) {
-    const Token token = expect_token("'" + std::string(keyword) + "'");
-    if (!iequals(token.text, keyword))
-      fail_at(token.line, "expected '" + std::string(keyword) + "', found " + quoted(token.text));
-    return token;
-  }
-  void skip_line() { rest_of_line(); }
-  // The raw rest of the current line (comments included), moving to the start of the next one.
-  std::string_view rest_of_line() {
-    const std::size_t end = bytes_.find('\n', pos_);
-    const std::string_view rest = bytes_.substr(pos_, end == std::string_view::npos ? end : end - pos_);
-    pos_ = end == std::string_view::npos ? bytes_.size() : end + 1;
-    if (end != std::string_view::npos) ++line_;
-    return rest;
-  }
-  // Moves just past the next occurrence of `marker`; false (and no move) when there is none.
-  bool skip_past(std::string_view marker) { return text_until(marker).has_value(); }
-  // The raw text up to the next occurrence of `marker`, moving just past it; none (and no move) when
-  // there is none.
-  std::optional<std::string_view> text_until(std::string_view marker) {
-    const std::size_t found = bytes_.find(marker, pos_);
-    if (found == std::string_view::npos) return std::nullopt;
-    const std::string_view text = bytes_.substr(pos_, found - pos_);
-    const std::size_t end = found + marker.size();
-    line_ += static_cast<int>(std::ranges::count(bytes_.substr(pos_, end - pos_), '\n'));
-    pos_ = end;
-    return text;
-  }
-
-  long long integer(const Token& token, std::string_view what) const {
-    const std::string_view text = without_plus(token.text);
-    long long value = 0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error == std::errc::invalid_argument || end != text.data() + text.size())
-      fail_at(token.line, "malformed " + std::string(what) + " " + quoted(token.text));
-    if (error == std::errc::result_out_of_range)
-      fail_at(token.line, std::string(what) + " " + quoted(token.text) + " is out of range");
-    return value;
-  }
-  double number(const Token& token, std::string_view what) const {
-    const std::string_view text = without_plus(token.text);
-    double value = 0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (error == std::errc::invalid_argument || end != text.data() + text.size())
-      fail_at(token.line, "malformed " + std::string(what) + " " + quoted(token.text));
-    // from_chars leaves the value unset when out of range: overflow becomes infinite (and rejected
-    // by the callers that need finite values), underflow is as good as zero.
-    if (error == std::errc::result_out_of_range) value = std::strtod(std::string(text).c_str(), nullptr);
-    return value;
-  }
-  double coordinate(const Token& token) const {
-    const double value = number(token, "coordinate");
-    if (!std::isfinite(value)) fail_at(token.line, "non-finite coordinate " + quoted(token.text));
-    return value;
-  }
-
-  template <class T>
-  T binary(std::string_view what, std::endian order = std::endian::native) {
-    binary_seen_ = true;
-    if (remaining() < sizeof(T)) fail("unexpected end of file (reading " + std::string(what) + ")");
-    std::array<char, sizeof(T)> raw;
-    std::memcpy(raw.data(), bytes_.data() + pos_, sizeof(T));
-    if (order != std::endian::native) std::ranges::reverse(raw);
-    T value;
-    std::memcpy(&value, raw.data(), sizeof(T));
-    pos_ += sizeof(T);
-    return value;
-  }
-  void skip_bytes(std::uint64_t count, std::string_view what) {
-    binary_seen_ = true;
-    if (count > remaining()) fail("unexpected end of file (reading " + std::string(what) + ")");
-    pos_ += static_cast<std::size_t>(count);
-  }
-
-  // Refuses a header count whose items, at `min_bytes` each, cannot fit in the rest of the file.
-  void check_count(std::uint64_t count, std::uint64_t min_bytes, std::string_view what) const {
-    if (count > remaining() / min_bytes)
-      fail("absurd " + std::string(what) + " count " + std::to_string(count) + ": cannot fit in the " +
-           std::to_string(remaining()) + " bytes left in the file");
-  }
-
-  [[noreturn]] void fail(const std::string& defect) const { fail_at(line_, defect); }
-  // At the end of the file, the last line: the one a final newline ends, not the empty one after it.
-  [[noreturn]] void fail_at_end(std::string_view what) const {
-    const bool final_newline = !bytes_.empty() && bytes_.back() == '\n';
-    fail_at(final_newline ? line_ - 1 : line_, "unexpected end of file (expected " + std::string(what) + ")");
-  }
-  [[noreturn]] void fail_at(int line, const std::string& defect) const {
-    if (binary_seen_) fail_file(path_, defect);  // line numbers mean nothing after binary data
-    throw InputError(path_ + ":" + std::to_string(line) + ": " + defect);
-  }
-
- private:
-  // from_chars rejects a leading '+', which text formats allow.
-  static std::string_view without_plus(std::string_view text) {
-    if (text.size() > 1 && text[0] == '+' && text[1] != '-' && text[1] != '+') text.remove_prefix(1);
-    return text;
-  }
-  static bool is_blank(char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\f' || ch == '\v'; }
-
-  void skip_blanks(bool cross_lines) {
-    while (pos_ < bytes_.size()) {
-      const char ch = bytes_[pos_];
-      if (ch == '\n') {
-        if (!cross_lines) return;
-        ++line_;
-        ++pos_;
-      } else if (is_blank(ch)) {
-        ++pos_;
-      } else if (comment_ != '\0' && ch == comment_) {
-        const std::size_t end = bytes_.find('\n', pos_);
-        pos_ = end == std::string_view::npos ? bytes_.size() : end;
-      } else {
-        return;
-      }
-    }
-  }
-  std::optional<Token> token_here() {
-    if (pos_ == bytes_.size() || bytes_[pos_] == '\n') return std::nullopt;
-    const std::size_t begin = pos_;
-    while (pos_ < bytes_.size() && bytes_[pos_] != '\n' && !is_blank(bytes_[pos_]) &&
-           (comment_ == '\0' || bytes_[pos_] != comment_))
-      ++pos_;
-    return Token{bytes_.substr(begin, pos_ - begin), line_};
-  }
-
-  std::string path_;
-  std::string_view bytes_;
-  char comment_;
-  std::size_t pos_ = 0;
-  int line_ = 1;
-  bool binary_seen_ = false;
-};
 
 // Diagonal of the bounding box of the vertices that triangles use (an OBJ file may hold others).
 double used_bounding_box_diagonal(const TriangleSurface& surface) {
@@ -349,7 +153,7 @@ std::string index_range(long long first, long long count) {
 // ---------------------------------------------------------------------------------------------- OBJ
 
 TriangleSurface parse_obj(const std::string& path, std::string_view bytes, ReadContext& context) {
-  FileCursor cursor(path, bytes, '#');
+  ByteCursor cursor(path, bytes, '#');
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> triangles;
   std::vector<int> triangle_lines;  // positive indices may refer to later vertices: checked at the end
@@ -427,7 +231,7 @@ TriangleSurface parse_binary_stl(const std::string& path, std::string_view bytes
                                                  : " (unexpected data after the last triangle)"));
   if (count > std::numeric_limits<int>::max() / 3)
     fail_file(path, std::to_string(count) + " triangles: more than a surface can hold");
-  FileCursor cursor(path, bytes);
+  ByteCursor cursor(path, bytes);
   cursor.skip_bytes(kStlHeaderBytes, "header");
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> triangles;
@@ -449,7 +253,7 @@ TriangleSurface parse_binary_stl(const std::string& path, std::string_view bytes
 }
 
 TriangleSurface parse_ascii_stl(const std::string& path, std::string_view bytes, ReadContext& context) {
-  FileCursor cursor(path, bytes);
+  ByteCursor cursor(path, bytes);
   std::vector<Eigen::Vector3d> points;
   std::vector<Triangle> triangles;
   cursor.expect_keyword("solid");
@@ -513,7 +317,7 @@ bool is_off_keyword(std::string_view text) {
 }
 
 TriangleSurface parse_off(const std::string& path, std::string_view bytes, ReadContext& context) {
-  FileCursor cursor(path, bytes, '#');
+  ByteCursor cursor(path, bytes, '#');
   const Token header = cursor.expect_token("'OFF' header");
   if (!is_off_keyword(header.text))
     cursor.fail_at(header.line, "expected the 'OFF' header, found " + quoted(header.text));
@@ -561,287 +365,19 @@ TriangleSurface parse_off(const std::string& path, std::string_view bytes, ReadC
 
 // ---------------------------------------------------------------------------------------------- MSH
 
-constexpr long long kGmshTriangle = 2;  // element type of the 3-node triangle
+constexpr int kGmshTriangle = 2;  // element type of the 3-node triangle
 
-// Nodes of the Gmsh element types, to skip the other elements of a binary file; 0 when unknown.
-int gmsh_nodes_per_element(long long type) {
-  constexpr std::array<int, 32> kNodes = {0, 2,  3,  4,  4,  8, 6,  5,  3,  6,  9,  10, 27, 18, 14, 1,
-                                          8, 20, 15, 13, 9, 10, 12, 15, 15, 21, 4,  5,  6,  20, 35, 56};
-  if (type >= 0 && type < static_cast<long long>(kNodes.size())) return kNodes[static_cast<std::size_t>(type)];
-  if (type == 92) return 64;   // third-order hexahedron
-  if (type == 93) return 125;  // fourth-order hexahedron
-  return 0;
-}
-
-// Gmsh MSH 2.2 and 4.1, ASCII or binary (native byte order, 8-byte size_t). Only the nodes and the
-// 3-node triangles are read; the other sections are skipped, the other elements ignored.
-class MshReader {
- public:
-  MshReader(const std::string& path, std::string_view bytes) : cursor_(path, bytes) {}
-
-  TriangleSurface read(ReadContext& context) {
-    read_format();
-    while (const std::optional<Token> section = cursor_.next_token()) {
-      if (!section->text.starts_with('$'))
-        cursor_.fail_at(section->line, "expected a section such as '$Nodes', found " + quoted(section->text));
-      const std::string name(section->text.substr(1));
-      const std::string end = "$End" + name;
-      if (name == "Nodes" || name == "Elements") {
-        if (binary_ && version4_) cursor_.skip_line();  // binary data starts on the next line
-        if (name == "Nodes")
-          version4_ ? read_nodes_v4() : read_nodes_v2();
-        else
-          version4_ ? read_elements_v4() : read_elements_v2();
-        const Token end_token = cursor_.expect_token("'" + end + "'");
-        if (end_token.text != end)
-          cursor_.fail_at(end_token.line, "expected '" + end + "', found " + quoted(end_token.text));
-      } else if (!cursor_.skip_past(end)) {
-        cursor_.fail_at(section->line, "section " + quoted(section->text) + " has no '" + end + "'");
-      }
-    }
-    std::vector<Triangle> triangles;
-    triangles.reserve(pending_.size());
-    for (const PendingTriangle& pending : pending_) {
-      Triangle& triangle = triangles.emplace_back();
-      for (int k = 0; k < 3; ++k) {
-        const auto found = node_index_.find(pending.nodes[k]);
-        if (found == node_index_.end())
-          fail_file(cursor_.path(), "element " + std::to_string(pending.element) + ": node " +
-                                        std::to_string(pending.nodes[k]) + " is not defined in $Nodes");
-        triangle[k] = found->second;
-      }
-    }
-    if (triangles.empty()) fail_file(cursor_.path(), "no triangles (element type 2) in the file");
-    return finish_surface(cursor_.path(), std::move(points_), std::move(triangles), context);
-  }
-
- private:
-  struct PendingTriangle {  // node tags are resolved once all sections are read
-    std::uint64_t element;
-    std::array<std::uint64_t, 3> nodes;
-  };
-
-  void read_format() {
-    const Token start = cursor_.expect_token("'$MeshFormat'");
-    if (start.text != "$MeshFormat")
-      cursor_.fail_at(start.line, "not a Gmsh MSH file: expected '$MeshFormat', found " + quoted(start.text));
-    const Token version = cursor_.expect_token("MSH version");
-    version4_ = version.text == "4.1";
-    if (!version4_ && version.text != "2.2")
-      cursor_.fail_at(version.line, "unsupported MSH version " + quoted(version.text) + " (supported: 2.2, 4.1)");
-    const Token type = cursor_.expect_token("file type");
-    const long long file_type = cursor_.integer(type, "file type");
-    if (file_type != 0 && file_type != 1)
-      cursor_.fail_at(type.line, "file type " + quoted(type.text) + " is neither 0 (ASCII) nor 1 (binary)");
-    binary_ = file_type == 1;
-    const Token size = cursor_.expect_token("data size");
-    if (binary_ && cursor_.integer(size, "data size") != 8)
-      cursor_.fail_at(size.line, "unsupported data size " + quoted(size.text) + " in a binary file (8 expected)");
-    if (binary_) {
-      cursor_.skip_line();
-      const auto one = cursor_.binary<std::int32_t>("endianness check");
-      if (one != 1)
-        cursor_.fail("binary endianness check reads " + std::to_string(one) +
-                     " instead of 1: the file was written with another byte order");
-    }
-    const Token end = cursor_.expect_token("'$EndMeshFormat'");
-    if (end.text != "$EndMeshFormat")
-      cursor_.fail_at(end.line, "expected '$EndMeshFormat', found " + quoted(end.text));
-  }
-
-  // Fields typed 'int' in binary files.
-  long long int_field(std::string_view what) {
-    if (binary_) return cursor_.binary<std::int32_t>(what);
-    return cursor_.integer(cursor_.expect_token(what), what);
-  }
-  // Fields typed 'size_t' in binary files (MSH 4.1 only).
-  std::uint64_t size_field(std::string_view what) {
-    if (binary_) return cursor_.binary<std::uint64_t>(what);
-    const Token token = cursor_.expect_token(what);
-    const long long value = cursor_.integer(token, what);
-    if (value < 0) cursor_.fail_at(token.line, std::string(what) + " " + std::to_string(value) + " is negative");
-    return static_cast<std::uint64_t>(value);
-  }
-  // Node and element tags: 'int' in MSH 2.2 binary files, 'size_t' in MSH 4.1 ones.
-  std::uint64_t tag_field(std::string_view what) {
-    if (!binary_ || version4_) return size_field(what);
-    const long long tag = int_field(what);
-    if (tag < 0) cursor_.fail(std::string(what) + " " + std::to_string(tag) + " is negative");
-    return static_cast<std::uint64_t>(tag);
-  }
-  // MSH 2.2 gives the section counts as text even in binary files, whose data starts on the next line.
-  std::uint64_t text_count(std::string_view what) {
-    const Token token = cursor_.expect_token(what);
-    const long long count = cursor_.integer(token, what);
-    if (count < 0) cursor_.fail_at(token.line, "negative " + std::string(what));
-    if (binary_) cursor_.skip_line();
-    return static_cast<std::uint64_t>(count);
-  }
-  double real_field(std::string_view what) {
-    if (binary_) return cursor_.binary<double>(what);
-    return cursor_.number(cursor_.expect_token(what), what);
-  }
-  Eigen::Vector3d node_point(std::uint64_t tag) {
-    Eigen::Vector3d p;
-    for (int axis = 0; axis < 3; ++axis) {
-      if (!binary_) {
-        p[axis] = cursor_.coordinate(cursor_.expect_token("node coordinate"));
-        continue;
-      }
-      p[axis] = cursor_.binary<double>("node coordinate");
-      if (!std::isfinite(p[axis])) cursor_.fail("node " + std::to_string(tag) + ": non-finite coordinate");
-    }
-    return p;
-  }
-  void add_node(std::uint64_t tag, const Eigen::Vector3d& point) {
-    if (!node_index_.emplace(tag, static_cast<int>(points_.size())).second)
-      cursor_.fail("node tag " + std::to_string(tag) + " is defined twice");
-    points_.push_back(point);
-  }
-  void add_triangle(std::uint64_t element) {
-    PendingTriangle& triangle = pending_.emplace_back();
-    triangle.element = element;
-    for (std::uint64_t& node : triangle.nodes) node = tag_field("node tag");
-  }
-  // Skips `count` binary elements of `type`, each made of `ints_besides_nodes` plus its node tags.
-  void skip_binary_elements(long long type, std::uint64_t count, std::uint64_t ints_besides_nodes,
-                            std::uint64_t int_bytes) {
-    const int nodes = gmsh_nodes_per_element(type);
-    if (nodes == 0)
-      cursor_.fail("unsupported element type " + std::to_string(type) + " in a binary file (its node count is unknown)");
-    const std::uint64_t element_bytes = (ints_besides_nodes + static_cast<std::uint64_t>(nodes)) * int_bytes;
-    cursor_.check_count(count, element_bytes, "element");
-    cursor_.skip_bytes(count * element_bytes, "elements");
-  }
-  void check_block(std::uint64_t in_block, std::uint64_t read, std::uint64_t announced, std::string_view what) {
-    if (in_block > announced - read)
-      cursor_.fail("a block of " + std::to_string(in_block) + " " + std::string(what) + "s exceeds the " +
-                   std::to_string(announced) + " announced by the section header");
-  }
-
-  void read_nodes_v2() {
-    const std::uint64_t count = text_count("number of nodes");
-    cursor_.check_count(count, binary_ ? 4 + 3 * 8 : 7, "node");
-    points_.reserve(points_.size() + count);
-    node_index_.reserve(node_index_.size() + count);
-    for (std::uint64_t i = 0; i < count; ++i) {
-      const std::uint64_t tag = tag_field("node tag");
-      add_node(tag, node_point(tag));
-    }
-  }
-
-  void read_elements_v2() {
-    const std::uint64_t count = text_count("number of elements");
-    cursor_.check_count(count, binary_ ? 8 : 7, "element");
-    if (!binary_) {  // one element per line: tag, type, number of tags, tags, nodes
-      for (std::uint64_t i = 0; i < count; ++i) {
-        const std::uint64_t element = tag_field("element tag");
-        if (cursor_.integer(cursor_.expect_token_on_line("element type"), "element type") == kGmshTriangle) {
-          const long long tags = cursor_.integer(cursor_.expect_token_on_line("number of tags"), "number of tags");
-          for (long long k = 0; k < tags; ++k) cursor_.expect_token_on_line("element tag");
-          add_triangle(element);
-        }
-        cursor_.skip_line();
-      }
-      return;
-    }
-    // Binary elements come in blocks sharing a header: type, number of elements, number of tags.
-    for (std::uint64_t read = 0; read < count;) {
-      const long long type = int_field("element type");
-      const long long in_block = int_field("number of elements in block");
-      const long long tags = int_field("number of tags");
-      if (in_block < 1 || tags < 0) cursor_.fail("malformed element block header");
-      const auto elements = static_cast<std::uint64_t>(in_block);
-      check_block(elements, read, count, "element");
-      if (type == kGmshTriangle) {
-        for (std::uint64_t i = 0; i < elements; ++i) {
-          const std::uint64_t element = tag_field("element tag");
-          cursor_.skip_bytes(static_cast<std::uint64_t>(tags) * 4, "element tags");
-          add_triangle(element);
-        }
-      } else {
-        skip_binary_elements(type, elements, 1 + static_cast<std::uint64_t>(tags), 4);
-      }
-      read += elements;
-    }
-  }
-
-  void read_nodes_v4() {
-    const std::uint64_t blocks = size_field("number of node blocks");
-    const std::uint64_t count = size_field("number of nodes");
-    size_field("minimum node tag");
-    size_field("maximum node tag");
-    cursor_.check_count(blocks, binary_ ? 20 : 7, "node block");
-    cursor_.check_count(count, binary_ ? 32 : 7, "node");
-    points_.reserve(points_.size() + count);
-    node_index_.reserve(node_index_.size() + count);
-    std::vector<std::uint64_t> tags;
-    std::uint64_t read = 0;
-    for (std::uint64_t b = 0; b < blocks; ++b) {
-      const long long dimension = int_field("entity dimension");
-      int_field("entity tag");
-      const long long parametric = int_field("parametric flag");
-      const std::uint64_t in_block = size_field("number of nodes in block");
-      if (dimension < 0 || dimension > 3) cursor_.fail("entity dimension " + std::to_string(dimension) + " is not 0..3");
-      if (parametric != 0 && parametric != 1) cursor_.fail("parametric flag " + std::to_string(parametric) + " is not 0 or 1");
-      check_block(in_block, read, count, "node");
-      tags.clear();  // all the tags of a block precede its coordinates
-      for (std::uint64_t i = 0; i < in_block; ++i) tags.push_back(tag_field("node tag"));
-      // Parametric nodes add u (curve), u v (surface) or u v w (volume) after x y z.
-      const long long parameters = parametric == 1 ? dimension : 0;
-      for (const std::uint64_t tag : tags) {
-        const Eigen::Vector3d point = node_point(tag);
-        for (long long k = 0; k < parameters; ++k) real_field("parametric coordinate");
-        add_node(tag, point);
-      }
-      read += in_block;
-    }
-    if (read != count)
-      cursor_.fail("node blocks hold " + std::to_string(read) + " nodes, the section header announces " +
-                   std::to_string(count));
-  }
-
-  void read_elements_v4() {
-    const std::uint64_t blocks = size_field("number of element blocks");
-    const std::uint64_t count = size_field("number of elements");
-    size_field("minimum element tag");
-    size_field("maximum element tag");
-    cursor_.check_count(blocks, binary_ ? 20 : 7, "element block");
-    cursor_.check_count(count, binary_ ? 16 : 3, "element");
-    std::uint64_t read = 0;
-    for (std::uint64_t b = 0; b < blocks; ++b) {
-      int_field("entity dimension");
-      int_field("entity tag");
-      const long long type = int_field("element type");
-      const std::uint64_t in_block = size_field("number of elements in block");
-      check_block(in_block, read, count, "element");
-      if (type == kGmshTriangle) {
-        for (std::uint64_t i = 0; i < in_block; ++i) add_triangle(tag_field("element tag"));
-      } else if (binary_) {
-        skip_binary_elements(type, in_block, 1, 8);
-      } else {
-        for (std::uint64_t i = 0; i < in_block; ++i) {  // one element per line: tag, nodes
-          cursor_.expect_token("element tag");
-          cursor_.skip_line();
-        }
-      }
-      read += in_block;
-    }
-    if (read != count)
-      cursor_.fail("element blocks hold " + std::to_string(read) + " elements, the section header announces " +
-                   std::to_string(count));
-  }
-
-  FileCursor cursor_;
-  bool binary_ = false;
-  bool version4_ = false;
-  std::vector<Eigen::Vector3d> points_;
-  std::unordered_map<std::uint64_t, int> node_index_;
-  std::vector<PendingTriangle> pending_;
-};
-
+// Gmsh MSH 2.2 and 4.1 (io/msh_parser.hpp): the 3-node triangles; other elements are ignored.
 TriangleSurface parse_msh(const std::string& path, std::string_view bytes, ReadContext& context) {
-  return MshReader(path, bytes).read(context);
+  constexpr std::array<int, 1> kKept{kGmshTriangle};
+  readers::MshFile file = readers::parse_msh_file(path, bytes, kKept);
+  const auto found = file.elements.find(kGmshTriangle);
+  if (found == file.elements.end()) fail_file(path, "no triangles (element type 2) in the file");
+  const std::vector<int>& vertices = found->second.vertices;
+  std::vector<Triangle> triangles(vertices.size() / 3);
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    triangles[t] = {vertices[3 * t], vertices[3 * t + 1], vertices[3 * t + 2]};
+  return finish_surface(path, std::move(file.points), std::move(triangles), context);
 }
 
 // -------------------------------------------------------------------------------------------- parts
@@ -1095,7 +631,7 @@ class TsurfReader {
             true};
   }
 
-  FileCursor cursor_;
+  ByteCursor cursor_;
   TsurfFile file_;
   std::vector<Eigen::Vector3d> points_;
   std::vector<Triangle> triangles_;

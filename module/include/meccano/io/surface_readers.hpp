@@ -12,10 +12,10 @@
 //         weld then drops the triangles it collapsed and the repeats of a triangle, and counts them.
 // Parts   the triangles joined through shared edges. A TSurf file of several parts is not one surface:
 //         read_surface refuses it, naming the parts; read_surface_parts returns them (any format).
-// Errors  InputError naming the file, the line (text formats) or the element, and the defect. A reader
-//         checks the syntax and the index ranges only; the geometric and topological requirements of
-//         the method (disk topology, no self-intersection, inside the box, ...) are checked by
-//         surface/validation.hpp.
+// Errors  InputError naming the file, the line (text formats), the byte offset (binary MSH data) or the
+//         element, and the defect. A reader checks the syntax and the index ranges only; the geometric
+//         and topological requirements of the method (disk topology, no self-intersection, inside the
+//         box, ...) are checked by surface/validation.hpp.
 #pragma once
 
 #include <meccano/surface/triangle_surface.hpp>

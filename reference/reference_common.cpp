@@ -8,94 +8,61 @@
 #include <array>
 #include <cctype>
 #include <cmath>
-#include <cstdlib>
 
 namespace meccano::reference {
 namespace {
 
-// Six separate numbers, or one comma-separated list as meccano-immerse takes it.
-Box parse_box(const std::vector<std::string>& args, std::size_t& i) {
-  const std::string& option = args[i];
+// --box: six separate numbers, or one comma-separated list as meccano-immerse takes it.
+Box parse_box(const std::string& first, tools::ArgumentParser& parser) {
   std::vector<std::string> items;
-  if (const std::string& first = option_value(args, i); first.find(',') != std::string::npos) {
+  if (first.find(',') != std::string::npos) {
     std::stringstream stream(first);
     for (std::string item; std::getline(stream, item, ',');) items.push_back(item);
   } else {
     items.push_back(first);
-    while (items.size() < 6 && i + 1 < args.size() && !args[i + 1].starts_with("--")) items.push_back(args[++i]);
+    while (items.size() < 6)
+      if (auto next = parser.next_value()) items.push_back(*next);
+      else break;
   }
-  if (items.size() != 6) throw UsageError(option + " takes 6 numbers: XMIN YMIN ZMIN XMAX YMAX ZMAX");
+  if (items.size() != 6) throw UsageError("--box takes 6 numbers: XMIN YMIN ZMIN XMAX YMAX ZMAX");
   std::array<double, 6> v{};
-  for (int k = 0; k < 6; ++k) v[k] = parse_number(option, items[k]);
-  return tools::box_from_numbers<UsageError>(option, v);
+  for (int k = 0; k < 6; ++k) v[k] = tools::parse_finite_number("--box", items[k]);
+  return tools::box_from_numbers("--box", v);
 }
 
-bool ends_with(const std::string& text, const std::string& suffix) {
-  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-// If args[i] is one of the common options, reads it and its values into `options`, leaves i at its
-// last value and returns true; returns false for any other argument.
-bool parse_common_option(const std::vector<std::string>& args, std::size_t& i, CommonOptions& options) {
-  const std::string& arg = args[i];
-  if (arg == "--box") {
-    options.box = parse_box(args, i);
-    options.box_given = true;
-  } else if (arg == "--surface") {
-    options.surfaces.push_back(tools::parse_surface_argument<UsageError>(option_value(args, i), options.surfaces.size() + 1));
-  } else if (arg == "--size") {
-    options.size = parse_number(arg, option_value(args, i));
+void declare_common_options(tools::ArgumentParser& parser, const char* usage_text, CommonOptions& options) {
+  parser.help(usage_text);
+  parser.required_value({"--box"}, [&](const std::string& first) { options.box = parse_box(first, parser); });
+  parser.required_value({"--surface"}, [&](const std::string& text) {
+    options.surfaces.push_back(tools::parse_surface_argument(text, options.surfaces.size() + 1));
+  });
+  parser.required_value({"--size"}, [&](const std::string& text) {
+    options.size = tools::parse_finite_number("--size", text);
     if (!(*options.size > 0)) throw UsageError("--size must be positive");
-  } else if (arg == "--output" || arg == "-o") {
-    options.output = option_value(args, i);
-  } else if (arg == "--report") {
-    options.report = option_value(args, i);
-  } else if (arg == "--quiet" || arg == "-q") {
-    options.quiet = true;
-  } else {
-    return false;
-  }
-  return true;
+  });
+  parser.required_value({"--output", "-o"}, [&](const std::string& path) { options.output = path; });
+  parser.value({"--report"}, [&](const std::string& path) { options.report = path; });
+  parser.flag({"--quiet", "-q"}, [&] { options.quiet = true; });
 }
 
-// What parse_arguments checks once every argument is read.
+// What parse_arguments checks once every argument is read, past the required options.
 void check_common_options(const CommonOptions& options) {
-  if (!options.box_given) throw UsageError("--box is required");
-  if (options.surfaces.empty()) throw UsageError("--surface is required");
-  if (!options.size) throw UsageError("--size is required");
-  if (options.output.empty()) throw UsageError("--output is required");
-  if (!ends_with(options.output, ".msh"))
+  if (options.output.empty()) throw UsageError("--output is required");  // given as "", as it always was
+  if (!options.output.ends_with(".msh"))
     throw UsageError("--output " + options.output + ": only .msh output is supported");
-  if (options.report && !ends_with(*options.report, ".json"))
+  if (options.report && !options.report->ends_with(".json"))
     throw UsageError("--report " + *options.report + ": the report is a .json file");
-  for (std::size_t i = 0; i < options.surfaces.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (options.surfaces[i].second == options.surfaces[j].second)
-        throw UsageError("two surfaces are named " + options.surfaces[i].second);
+  tools::check_distinct_names(options.surfaces);
 }
 
 }  // namespace
 
-const std::string& option_value(const std::vector<std::string>& args, std::size_t& i) {
-  if (i + 1 >= args.size()) throw UsageError(args[i] + " needs a value");
-  return args[++i];
-}
-
-double parse_number(const std::string& option, const std::string& text) {
-  return tools::parse_finite_number<UsageError>(option, text);
-}
-
 void parse_arguments(int argc, char** argv, const char* usage_text, CommonOptions& common,
-                     const ToolOptionParser& parse_tool_option) {
-  const std::vector<std::string> args(argv + 1, argv + argc);
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--help" || args[i] == "-h") {
-      std::cout << usage_text;
-      std::exit(0);
-    }
-    if (!parse_common_option(args, i, common) && !parse_tool_option(args, i))
-      throw UsageError("unknown option '" + args[i] + "'");
-  }
+                     const std::function<void(tools::ArgumentParser&)>& declare_tool_options) {
+  tools::ArgumentParser parser;
+  declare_common_options(parser, usage_text, common);
+  declare_tool_options(parser);
+  parser.parse({argv + 1, argv + argc});
   check_common_options(common);
 }
 
@@ -193,18 +160,6 @@ void write_outputs(const CommonOptions& common, const Progress& progress, const 
   files.commit();
   progress.say("wrote ", common.output);
   if (common.report) progress.say("wrote ", *common.report);
-}
-
-int run_tool(const std::string& tool, const std::function<int()>& parse_and_run) {
-  try {
-    return parse_and_run();
-  } catch (const UsageError& error) {
-    std::cerr << tool << ": " << error.what() << "\n(see " << tool << " --help)\n";
-    return 2;
-  } catch (const std::exception& error) {
-    std::cerr << tool << ": error: " << error.what() << '\n';
-    return 1;
-  }
 }
 
 }  // namespace meccano::reference

@@ -21,6 +21,7 @@
 #include <meccano/mesh/quality.hpp>
 #include <meccano/io/surface_readers.hpp>
 
+#include "arguments.hpp"
 #include "tool_support.hpp"
 
 #include <chrono>
@@ -30,20 +31,16 @@
 #include <iostream>
 #include <optional>
 #include <sstream>
-#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace meccano::reference {
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using tools::UsageError;
 
 struct CommonOptions {
   Box box;
-  bool box_given = false;
   std::vector<std::pair<std::string, std::string>> surfaces;  // file, name
   std::optional<double> size;
   std::string output;
@@ -51,22 +48,12 @@ struct CommonOptions {
   bool quiet = false;
 };
 
-// args[i] is an option that takes a value: returns args[i + 1] and advances i past it.
-const std::string& option_value(const std::vector<std::string>& args, std::size_t& i);
-
-// A finite number, the whole text; UsageError naming the option otherwise.
-double parse_number(const std::string& option, const std::string& text);
-
-// A tool's own options: reads args[i] (and its values, leaving i at the last) and returns true, or
-// returns false for an argument it does not know.
-using ToolOptionParser = std::function<bool(const std::vector<std::string>& args, std::size_t& i)>;
-
 // Reads the command line: --help (-h) prints usage_text and exits with status 0; the common options go
-// to `common`, every other argument to parse_tool_option; an argument neither knows is a UsageError.
-// Then checks that --box, --surface, --size and --output are given, the output is a .msh file, the
-// report a .json file, and no two surfaces have the same name.
+// to `common`, the tool's own to the handlers that declare_tool_options declares; an argument neither
+// knows is a UsageError. Then checks that --box, --surface, --size and --output are given, the output
+// is a .msh file, the report a .json file, and no two surfaces have the same name.
 void parse_arguments(int argc, char** argv, const char* usage_text, CommonOptions& common,
-                     const ToolOptionParser& parse_tool_option);
+                     const std::function<void(tools::ArgumentParser&)>& declare_tool_options);
 
 using Clock = std::chrono::steady_clock;
 
@@ -118,9 +105,5 @@ void write_report(const ReferenceRun& run, const std::function<void(JsonWriter&)
 using PathWriter = std::function<void(const std::string& path)>;
 void write_outputs(const CommonOptions& common, const Progress& progress, const PathWriter& mesh_writer,
                    const PathWriter& report_writer);
-
-// What main() of a tool does: runs parse_and_run and maps its exceptions to exit statuses, UsageError
-// to 2 with a pointer to --help, any other std::exception to 1, each message prefixed by the tool's name.
-int run_tool(const std::string& tool, const std::function<int()>& parse_and_run);
 
 }  // namespace meccano::reference

@@ -88,7 +88,7 @@ struct Options {
 };
 
 double parse_positive(const std::string& option, const std::string& text) {
-  const double number = meccano::reference::parse_number(option, text);
+  const double number = meccano::tools::parse_finite_number(option, text);
   if (!(number > 0)) throw UsageError(option + " must be positive");
   return number;
 }
@@ -97,26 +97,22 @@ Options parse_options(int argc, char** argv) {
   Options options;
   std::optional<double> size_near_surface, size_distance;
   meccano::reference::parse_arguments(argc, argv, usage_text, options.common,
-                                      [&](const std::vector<std::string>& args, std::size_t& i) {
-    const std::string& arg = args[i];
-    if (arg == "--algorithm") {
-      const std::string& name = meccano::reference::option_value(args, i);
-      if (name == "hxt") options.algorithm = Algorithm::hxt;
-      else if (name == "delaunay") options.algorithm = Algorithm::delaunay;
-      else throw UsageError("--algorithm " + name + ": the algorithms available are: hxt, delaunay");
-    } else if (arg == "--threads") {
-      const double threads = meccano::reference::parse_number(arg, meccano::reference::option_value(args, i));
+                                      [&](meccano::tools::ArgumentParser& parser) {
+    parser.value({"--algorithm"}, [&](const std::string& text) {
+      options.algorithm = meccano::tools::parse_choice<Algorithm>(
+          "--algorithm", text, {{"hxt", Algorithm::hxt}, {"delaunay", Algorithm::delaunay}},
+          "the algorithms available are: hxt, delaunay");
+    });
+    parser.value({"--threads"}, [&](const std::string& text) {
+      const double threads = meccano::tools::parse_finite_number("--threads", text);
       if (threads != std::floor(threads) || threads < 1 || threads > 1024)
         throw UsageError("--threads takes an integer between 1 and 1024");
       options.threads = static_cast<int>(threads);
-    } else if (arg == "--size-near-surface") {
-      size_near_surface = parse_positive(arg, meccano::reference::option_value(args, i));
-    } else if (arg == "--size-distance") {
-      size_distance = parse_positive(arg, meccano::reference::option_value(args, i));
-    } else {
-      return false;
-    }
-    return true;
+    });
+    parser.value({"--size-near-surface"},
+                 [&](const std::string& text) { size_near_surface = parse_positive("--size-near-surface", text); });
+    parser.value({"--size-distance"},
+                 [&](const std::string& text) { size_distance = parse_positive("--size-distance", text); });
   });
   if (size_near_surface.has_value() != size_distance.has_value())
     throw UsageError("--size-near-surface and --size-distance go together: give both or neither");
@@ -377,7 +373,7 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return meccano::reference::run_tool("reference-gmsh", [&] {
+  return meccano::tools::run_reporting_errors("reference-gmsh", [&] {
     try {
       return run(parse_options(argc, argv));
     } catch (const std::string& gmsh_error) {  // the Gmsh 4.8 API throws its error messages as strings

@@ -97,25 +97,20 @@ const double equilateral_dihedral_deg = std::acos(1.0 / 3.0) * 180.0 / std::numb
 Options parse_options(int argc, char** argv) {
   Options options;
   meccano::reference::parse_arguments(argc, argv, usage_text, options.common,
-                                      [&](const std::vector<std::string>& args, std::size_t& i) {
-    const std::string& arg = args[i];
-    if (arg == "--radius-edge") {
-      options.radius_edge = meccano::reference::parse_number(arg, meccano::reference::option_value(args, i));
+                                      [&](meccano::tools::ArgumentParser& parser) {
+    parser.value({"--radius-edge"}, [&](const std::string& text) {
+      options.radius_edge = meccano::tools::parse_finite_number("--radius-edge", text);
       if (!(options.radius_edge >= 1.0))
         throw UsageError("--radius-edge must be at least 1 (TetGen need not terminate below)");
-    } else if (arg == "--min-dihedral") {
-      options.min_dihedral_deg = meccano::reference::parse_number(arg, meccano::reference::option_value(args, i));
+    });
+    parser.value({"--min-dihedral"}, [&](const std::string& text) {
+      options.min_dihedral_deg = meccano::tools::parse_finite_number("--min-dihedral", text);
       if (!(*options.min_dihedral_deg > 0.0 && *options.min_dihedral_deg < equilateral_dihedral_deg))
         throw UsageError("--min-dihedral must lie between 0 and " + std::to_string(equilateral_dihedral_deg) +
                          " degrees (the equilateral tet's)");
-    } else if (arg == "--keep-surface") {
-      options.keep_surface = true;
-    } else if (arg == "--verbose") {
-      options.verbose = true;
-    } else {
-      return false;
-    }
-    return true;
+    });
+    parser.flag({"--keep-surface"}, [&] { options.keep_surface = true; });
+    parser.flag({"--verbose"}, [&] { options.verbose = true; });
   });
   if (options.verbose && options.common.quiet) throw UsageError("--quiet and --verbose exclude each other");
   return options;
@@ -382,5 +377,5 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return meccano::reference::run_tool("reference-tetgen", [&] { return run(parse_options(argc, argv)); });
+  return meccano::tools::run_reporting_errors("reference-tetgen", [&] { return run(parse_options(argc, argv)); });
 }

@@ -1,32 +1,28 @@
 #include "command_line.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <iostream>
 
 namespace solver_demo {
 
+namespace {
+
 Options parse_options(int argc, char** argv, const std::vector<std::string>& known,
                       const std::vector<std::string>& required) {
   Options options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string name = argv[i];
-    if (std::find(known.begin(), known.end(), name) == known.end()) throw UsageError("unknown option '" + name + "'");
-    if (i + 1 >= argc) throw UsageError(name + " needs a value");
-    if (!options.emplace(name, argv[++i]).second) throw UsageError(name + " is given twice");
+  meccano::tools::ArgumentParser parser;
+  for (const std::string& name : known) {
+    auto store_once = [&options, name](const std::string& value) {
+      if (!options.emplace(name, value).second) throw UsageError(name + " is given twice");
+    };
+    if (std::find(required.begin(), required.end(), name) != required.end()) parser.required_value({name}, store_once);
+    else parser.value({name}, store_once);
   }
-  for (const std::string& name : required)
-    if (!options.count(name)) throw UsageError(name + " is required");
+  parser.parse({argv + 1, argv + argc});
   return options;
 }
 
-int parse_positive_int(const std::string& option, const std::string& text) {
-  int value = 0;
-  const char* end = text.data() + text.size();
-  const auto [stop, error] = std::from_chars(text.data(), end, value);
-  if (error != std::errc() || stop != end || value < 1) throw UsageError(option + ": '" + text + "' is not a positive integer");
-  return value;
-}
+}  // namespace
 
 unsigned int parse_degree(const std::string& text) {
   if (text != "1" && text != "2") throw UsageError("--degree " + text + ": the degrees are 1 and 2");

@@ -3,26 +3,22 @@
 // 2 usage error).
 #pragma once
 
+#include "arguments.hpp"
+
 #include <deal.II/base/mpi.h>
 
 #include <functional>
 #include <map>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace solver_demo {
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using meccano::tools::UsageError;
 
 // `--name value` pairs. Every name must be one of `known`, given once; `required` ones must be given.
 using Options = std::map<std::string, std::string>;
-Options parse_options(int argc, char** argv, const std::vector<std::string>& known,
-                      const std::vector<std::string>& required);
 
-int parse_positive_int(const std::string& option, const std::string& text);
 unsigned int parse_degree(const std::string& text);  // 1 or 2
 
 // Initialises MPI, prints `usage` for --help, runs `body` and maps its exceptions to exit statuses,

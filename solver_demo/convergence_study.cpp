@@ -94,7 +94,7 @@ std::string rate_text(double error, double h, const Row* previous, double Row::*
 }
 
 void study(MPI_Comm communicator, const Options& options) {
-  const int levels = parse_positive_int("--levels", options.at("--levels"));
+  const int levels = meccano::tools::parse_positive_integer("--levels", options.at("--levels"));
   if (levels > 5) throw UsageError("--levels " + options.at("--levels") + ": at most 5");
   const unsigned int degree = parse_degree(options.at("--degree"));
   const bool root = dealii::Utilities::MPI::this_mpi_process(communicator) == 0;

@@ -14,6 +14,7 @@
 #include <meccano/io/surface_readers.hpp>
 #include <meccano/surface/validation.hpp>
 
+#include "arguments.hpp"
 #include "tool_support.hpp"
 
 #include <array>
@@ -21,10 +22,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <iostream>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -162,29 +161,9 @@ Examples:
   meccano-immerse measure fault.msh --surface patch.obj:fault --report fault_measure.json
 )";
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-constexpr std::array<std::pair<const char*, meccano::Stage>, 4> stage_names{{
-    {"volumetric", meccano::Stage::volumetric},
-    {"approximation", meccano::Stage::approximation},
-    {"projection", meccano::Stage::projection},
-    {"smoothing", meccano::Stage::smoothing}}};
-
-std::optional<meccano::Stage> stage_named(const std::string& name) {
-  for (const auto& [text, stage] : stage_names)
-    if (name == text) return stage;
-  return std::nullopt;
-}
-
-std::optional<meccano::SideRule> side_rule_named(const std::string& name) {
-  if (name == "positive") return meccano::SideRule::positive_first;
-  if (name == "negative") return meccano::SideRule::negative_first;
-  if (name == "positive-only") return meccano::SideRule::positive_only;
-  if (name == "negative-only") return meccano::SideRule::negative_only;
-  return std::nullopt;
-}
+using meccano::tools::ArgumentParser;
+using meccano::tools::parse_choice;
+using meccano::tools::UsageError;
 
 struct Output {
   std::string path;
@@ -193,7 +172,6 @@ struct Output {
 
 struct Options {
   meccano::Box box;
-  bool box_given = false;
   std::optional<std::array<int, 3>> cells;
   int level = 0;
   std::vector<Output> outputs;
@@ -201,7 +179,7 @@ struct Options {
   meccano::SurfaceReadOptions reading;
   bool split_parts = false;
   std::optional<double> resolution;
-  std::optional<std::string> stage;
+  std::optional<meccano::Stage> stage;
   meccano::SideRule side_rule = meccano::SideRule::positive_first;
   double crease_angle = meccano::default_crease_angle;
   meccano::SmoothingOptions smoothing;
@@ -215,169 +193,163 @@ struct Options {
   bool quiet = false;
 };
 
-std::pair<std::string, std::string> parse_surface(const std::string& text, std::size_t position) {
-  return meccano::tools::parse_surface_argument<UsageError>(text, position);
+// An integer option's handler: stores the value, refused below `minimum`.
+template <class Int>
+ArgumentParser::ValueHandler store_integer(const std::string& option, Int& target, Int minimum) {
+  return [option, &target, minimum](const std::string& text) {
+    target = meccano::tools::parse_integer<Int>(option, text);
+    if (target < minimum)
+      throw UsageError(option +
+                       (minimum == 0 ? " must not be negative" : " must be at least " + std::to_string(minimum)));
+  };
 }
 
-std::vector<double> parse_numbers(const std::string& option, const std::string& text, std::size_t count) {
-  std::vector<double> values;
-  std::stringstream stream(text);
-  std::string item;
-  while (std::getline(stream, item, ',')) values.push_back(meccano::tools::parse_finite_number<UsageError>(option, item));
-  if (values.size() != count)
-    throw UsageError(option + " takes " + std::to_string(count) + " comma-separated numbers, got '" + text + "'");
-  return values;
+// The box, its meccano mesh and the surfaces to insert.
+void declare_input_options(ArgumentParser& parser, Options& options) {
+  parser.required_value({"--box"}, [&](const std::string& text) {
+    const auto v = meccano::tools::parse_numbers("--box", text, 6);
+    options.box = meccano::tools::box_from_numbers("--box", {v[0], v[1], v[2], v[3], v[4], v[5]});
+  });
+  parser.value({"--cells"}, [&](const std::string& text) {
+    const auto v = meccano::tools::parse_numbers("--cells", text, 3);
+    std::array<int, 3> cells{};
+    for (int k = 0; k < 3; ++k) {
+      if (!(v[k] == std::floor(v[k]) && v[k] >= 1 && v[k] <= meccano::max_cells_per_axis))
+        throw UsageError("--cells takes three integers from 1 to " + std::to_string(meccano::max_cells_per_axis));
+      cells[k] = static_cast<int>(v[k]);
+    }
+    options.cells = cells;
+  });
+  parser.value({"--level"}, [&](const std::string& text) {
+    options.level = meccano::tools::parse_integer("--level", text);
+    if (options.level < 0 || options.level > 40) throw UsageError("--level must be between 0 and 40");
+  });
+  parser.value({"--surface"}, [&](const std::string& text) {
+    options.surfaces.push_back(meccano::tools::parse_surface_argument(text, options.surfaces.size() + 1));
+  });
+  // Single numbers go through the comma-separated reader, as they always did: "1," reads as 1.
+  parser.value({"--weld-tolerance"}, [&](const std::string& text) {
+    const double tolerance = meccano::tools::parse_numbers("--weld-tolerance", text, 1)[0];
+    if (tolerance < 0) throw UsageError("--weld-tolerance must not be negative");
+    options.reading.weld_tolerance = tolerance;
+  });
+  parser.flag({"--split-parts"}, [&] { options.split_parts = true; });
+  parser.value({"--resolution"}, [&](const std::string& text) {
+    const double l = meccano::tools::parse_numbers("--resolution", text, 1)[0];
+    if (!(l > 0)) throw UsageError("--resolution must be positive");
+    options.resolution = l;
+  });
 }
 
-template <class Int = int>
-Int parse_int(const std::string& option, const std::string& text) {
-  std::size_t used = 0;
-  long long value = 0;
-  try {
-    value = std::stoll(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::in_range<Int>(value))
-    throw UsageError(option + ": '" + text + "' is not an integer");
-  return static_cast<Int>(value);
+// How the surfaces are inserted: the stages, their choices and limits.
+void declare_method_options(ArgumentParser& parser, Options& options) {
+  parser.value({"--stage"}, [&](const std::string& text) {
+    options.stage =
+        parse_choice<meccano::Stage>("--stage", text,
+                                     {{"volumetric", meccano::Stage::volumetric},
+                                      {"approximation", meccano::Stage::approximation},
+                                      {"projection", meccano::Stage::projection},
+                                      {"smoothing", meccano::Stage::smoothing}},
+                                     "the stages available are: volumetric, approximation, projection, smoothing");
+  });
+  parser.value({"--crease-angle"}, [&](const std::string& text) {
+    const double angle = meccano::tools::parse_numbers("--crease-angle", text, 1)[0];
+    if (!(angle > 0.0 && angle <= 180.0)) throw UsageError("--crease-angle must be above 0 and at most 180 degrees");
+    options.crease_angle = angle;
+  });
+  parser.value({"--side"}, [&](const std::string& text) {
+    options.side_rule =
+        parse_choice<meccano::SideRule>("--side", text,
+                                        {{"positive", meccano::SideRule::positive_first},
+                                         {"negative", meccano::SideRule::negative_first},
+                                         {"positive-only", meccano::SideRule::positive_only},
+                                         {"negative-only", meccano::SideRule::negative_only}},
+                                        "the rules are positive, negative, positive-only and negative-only");
+  });
+  parser.value({"--smoothing"}, [&](const std::string& text) {
+    options.smoothing.mode = parse_choice<meccano::SmoothingMode>(
+        "--smoothing", text, {{"whole", meccano::SmoothingMode::whole_mesh}, {"band", meccano::SmoothingMode::band}},
+        "the modes are whole and band");
+  });
+  parser.value({"--band-rings"}, store_integer("--band-rings", options.smoothing.band_rings, 1));
+  parser.value({"--target"}, [&](const std::string& text) {
+    options.smoothing.target = parse_choice<meccano::SmoothingTarget>(
+        "--target", text,
+        {{"meccano", meccano::SmoothingTarget::meccano}, {"equilateral", meccano::SmoothingTarget::equilateral}},
+        "the targets are meccano and equilateral");
+  });
+  parser.value({"--improve"}, [&](const std::string& text) {
+    options.improve = parse_choice<meccano::Improvement>("--improve", text,
+                                                         {{"topology", meccano::Improvement::topology},
+                                                          {"smooth", meccano::Improvement::smooth},
+                                                          {"none", meccano::Improvement::none}},
+                                                         "the modes are topology, smooth and none");
+  });
+  parser.value({"--improve-threshold"}, [&](const std::string& text) {
+    options.improve_threshold = meccano::tools::parse_numbers("--improve-threshold", text, 1)[0];
+    if (!(options.improve_threshold > 0.0 && options.improve_threshold <= 1.0))
+      throw UsageError("--improve-threshold must be above 0 and at most 1");
+  });
+  parser.value({"--max-sweeps"}, store_integer("--max-sweeps", options.smoothing.max_sweeps, 1));
+  parser.value({"--finer-retries"}, store_integer("--finer-retries", options.finer_retries, 0));
+  parser.value({"--fallback-sweeps"}, store_integer("--fallback-sweeps", options.smoothing.fallback_sweeps, 0));
+  parser.value({"--threads"}, [&](const std::string& text) {
+    options.threads = meccano::tools::parse_integer("--threads", text);
+    if (*options.threads < 1) throw UsageError("--threads must be at least 1");
+  });
+  parser.value({"--max-tets"}, store_integer<std::int64_t>("--max-tets", options.max_tets, 1));
+}
+
+// What the run writes, and how much it says. An --msh-version applies to the outputs after it, so
+// `msh_version_unused` tells whether the last one had none.
+void declare_output_options(ArgumentParser& parser, Options& options, meccano::MeshWriteOptions& output_format,
+                            bool& msh_version_unused) {
+  parser.value({"--report"}, [&](const std::string& path) { options.report = path; });
+  parser.value({"--histograms"}, [&](const std::string& path) { options.histograms = path; });
+  parser.required_value({"--output", "-o"}, [&](const std::string& path) {
+    const auto format = meccano::mesh_format_of(path);
+    if (!format)
+      throw UsageError("--output " + path +
+                       ": unknown format; the extensions are .msh (Gmsh), .vtu (ParaView) and "
+                       ".mesh (Medit)");
+    if (*format == meccano::MeshFormat::msh) msh_version_unused = false;
+    options.outputs.push_back({path, output_format});
+  });
+  parser.value({"--msh-version"}, [&](const std::string& text) {
+    output_format.msh_version = parse_choice<meccano::MshVersion>(
+        "--msh-version", text, {{"4.1", meccano::MshVersion::v41}, {"2.2", meccano::MshVersion::v22}},
+        "the versions are 4.1 and 2.2");
+    msh_version_unused = true;
+  });
+  parser.flag({"--quiet", "-q"}, [&] { options.quiet = true; });
+}
+
+// What no single option can tell: the options that need or exclude one another.
+void check_option_combinations(const Options& options) {
+  if (!options.surfaces.empty() && !options.resolution) throw UsageError("--surface needs --resolution");
+  if (options.surfaces.empty() && (options.resolution || options.stage || options.histograms))
+    throw UsageError("--resolution, --stage and --histograms need at least one --surface");
+  if (options.histograms && options.stage && *options.stage != meccano::Stage::smoothing)
+    throw UsageError("--histograms compares the mesh before and after smoothing: it needs --stage smoothing");
+  if (options.surfaces.empty() && (options.reading.weld_tolerance || options.split_parts))
+    throw UsageError("--weld-tolerance and --split-parts need at least one --surface");
+  // Distinct names stay distinct with --split-parts, which splits every surface: in a part's NAME_K,
+  // K is what follows the last '_'.
+  meccano::tools::check_distinct_names(options.surfaces);
 }
 
 Options parse_options(int argc, char** argv) {
   Options options;
   meccano::MeshWriteOptions output_format;  // for the outputs that follow
   bool msh_version_unused = false;
-  std::vector<std::string> args(argv + 1, argv + argc);
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw UsageError(arg + " needs a value");
-      return args[++i];
-    };
-    if (arg == "--help" || arg == "-h") {
-      std::cout << usage_text;
-      std::exit(0);
-    } else if (arg == "--box") {
-      const auto v = parse_numbers(arg, value(), 6);
-      options.box = meccano::tools::box_from_numbers<UsageError>(arg, {v[0], v[1], v[2], v[3], v[4], v[5]});
-      options.box_given = true;
-    } else if (arg == "--cells") {
-      const auto v = parse_numbers(arg, value(), 3);
-      std::array<int, 3> cells{};
-      for (int k = 0; k < 3; ++k) {
-        if (!(v[k] == std::floor(v[k]) && v[k] >= 1 && v[k] <= meccano::max_cells_per_axis))
-          throw UsageError("--cells takes three integers from 1 to " + std::to_string(meccano::max_cells_per_axis));
-        cells[k] = static_cast<int>(v[k]);
-      }
-      options.cells = cells;
-    } else if (arg == "--level") {
-      options.level = parse_int(arg, value());
-      if (options.level < 0 || options.level > 40) throw UsageError("--level must be between 0 and 40");
-    } else if (arg == "--surface") {
-      options.surfaces.push_back(parse_surface(value(), options.surfaces.size() + 1));
-    } else if (arg == "--weld-tolerance") {
-      const double tolerance = parse_numbers(arg, value(), 1)[0];
-      if (tolerance < 0) throw UsageError("--weld-tolerance must not be negative");
-      options.reading.weld_tolerance = tolerance;
-    } else if (arg == "--crease-angle") {
-      const double angle = parse_numbers(arg, value(), 1)[0];
-      if (!(angle > 0.0 && angle <= 180.0)) throw UsageError("--crease-angle must be above 0 and at most 180 degrees");
-      options.crease_angle = angle;
-    } else if (arg == "--split-parts") {
-      options.split_parts = true;
-    } else if (arg == "--resolution") {
-      const double l = parse_numbers(arg, value(), 1)[0];
-      if (!(l > 0)) throw UsageError("--resolution must be positive");
-      options.resolution = l;
-    } else if (arg == "--stage") {
-      options.stage = value();
-      if (!stage_named(*options.stage))
-        throw UsageError("--stage " + *options.stage +
-                         ": the stages available are: volumetric, approximation, projection, smoothing");
-    } else if (arg == "--side") {
-      const std::string& rule = value();
-      const auto named = side_rule_named(rule);
-      if (!named)
-        throw UsageError("--side " + rule + ": the rules are positive, negative, positive-only and negative-only");
-      options.side_rule = *named;
-    } else if (arg == "--smoothing") {
-      const std::string& mode = value();
-      if (mode != "whole" && mode != "band") throw UsageError("--smoothing " + mode + ": the modes are whole and band");
-      options.smoothing.mode = mode == "band" ? meccano::SmoothingMode::band : meccano::SmoothingMode::whole_mesh;
-    } else if (arg == "--band-rings") {
-      options.smoothing.band_rings = parse_int(arg, value());
-      if (options.smoothing.band_rings < 1) throw UsageError("--band-rings must be at least 1");
-    } else if (arg == "--target") {
-      const std::string& target = value();
-      if (target != "meccano" && target != "equilateral")
-        throw UsageError("--target " + target + ": the targets are meccano and equilateral");
-      options.smoothing.target =
-          target == "meccano" ? meccano::SmoothingTarget::meccano : meccano::SmoothingTarget::equilateral;
-    } else if (arg == "--improve") {
-      const std::string& mode = value();
-      if (mode == "topology") options.improve = meccano::Improvement::topology;
-      else if (mode == "smooth") options.improve = meccano::Improvement::smooth;
-      else if (mode == "none") options.improve = meccano::Improvement::none;
-      else throw UsageError("--improve " + mode + ": the modes are topology, smooth and none");
-    } else if (arg == "--improve-threshold") {
-      options.improve_threshold = parse_numbers(arg, value(), 1)[0];
-      if (!(options.improve_threshold > 0.0 && options.improve_threshold <= 1.0))
-        throw UsageError("--improve-threshold must be above 0 and at most 1");
-    } else if (arg == "--max-sweeps") {
-      options.smoothing.max_sweeps = parse_int(arg, value());
-      if (options.smoothing.max_sweeps < 1) throw UsageError("--max-sweeps must be at least 1");
-    } else if (arg == "--finer-retries") {
-      options.finer_retries = parse_int(arg, value());
-      if (options.finer_retries < 0) throw UsageError("--finer-retries must not be negative");
-    } else if (arg == "--fallback-sweeps") {
-      options.smoothing.fallback_sweeps = parse_int(arg, value());
-      if (options.smoothing.fallback_sweeps < 0) throw UsageError("--fallback-sweeps must not be negative");
-    } else if (arg == "--threads") {
-      options.threads = parse_int(arg, value());
-      if (*options.threads < 1) throw UsageError("--threads must be at least 1");
-    } else if (arg == "--max-tets") {
-      options.max_tets = parse_int<std::int64_t>(arg, value());
-      if (options.max_tets < 1) throw UsageError("--max-tets must be at least 1");
-    } else if (arg == "--report") {
-      options.report = value();
-    } else if (arg == "--histograms") {
-      options.histograms = value();
-    } else if (arg == "--output" || arg == "-o") {
-      const std::string& path = value();
-      const auto format = meccano::mesh_format_of(path);
-      if (!format)
-        throw UsageError("--output " + path + ": unknown format; the extensions are .msh (Gmsh), .vtu (ParaView) and "
-                         ".mesh (Medit)");
-      if (*format == meccano::MeshFormat::msh) msh_version_unused = false;
-      options.outputs.push_back({path, output_format});
-    } else if (arg == "--msh-version") {
-      const std::string& version = value();
-      if (version != "4.1" && version != "2.2")
-        throw UsageError("--msh-version " + version + ": the versions are 4.1 and 2.2");
-      output_format.msh_version = version == "2.2" ? meccano::MshVersion::v22 : meccano::MshVersion::v41;
-      msh_version_unused = true;
-    } else if (arg == "--quiet" || arg == "-q") {
-      options.quiet = true;
-    } else {
-      throw UsageError("unknown option '" + arg + "'");
-    }
-  }
-  if (!options.box_given) throw UsageError("--box is required");
-  if (options.outputs.empty()) throw UsageError("--output is required");
+  ArgumentParser parser;
+  parser.help(usage_text);
+  declare_input_options(parser, options);
+  declare_method_options(parser, options);
+  declare_output_options(parser, options, output_format, msh_version_unused);
+  parser.parse({argv + 1, argv + argc});
   if (msh_version_unused) throw UsageError("--msh-version applies to the .msh outputs after it, and none follows");
-  if (!options.surfaces.empty() && !options.resolution) throw UsageError("--surface needs --resolution");
-  if (options.surfaces.empty() && (options.resolution || options.stage || options.histograms))
-    throw UsageError("--resolution, --stage and --histograms need at least one --surface");
-  if (options.histograms && options.stage && *options.stage != "smoothing")
-    throw UsageError("--histograms compares the mesh before and after smoothing: it needs --stage smoothing");
-  if (options.surfaces.empty() && (options.reading.weld_tolerance || options.split_parts))
-    throw UsageError("--weld-tolerance and --split-parts need at least one --surface");
-  // Distinct names stay distinct with --split-parts, which splits every surface: in a part's NAME_K,
-  // K is what follows the last '_'.
-  for (std::size_t i = 0; i < options.surfaces.size(); ++i)
-    for (std::size_t j = 0; j < i; ++j)
-      if (options.surfaces[i].second == options.surfaces[j].second)
-        throw UsageError("two surfaces are named " + options.surfaces[i].second);
+  check_option_combinations(options);
   return options;
 }
 
@@ -444,7 +416,7 @@ int run(const Options& options) {
 
   meccano::InsertionOptions insertion;
   insertion.resolution = options.resolution.value_or(0.0);
-  insertion.last_stage = options.stage ? *stage_named(*options.stage) : meccano::Stage::smoothing;
+  insertion.last_stage = options.stage.value_or(meccano::Stage::smoothing);
   insertion.approximation.side_rule = options.side_rule;
   insertion.projection.crease_angle = options.crease_angle;
   insertion.smoothing = options.smoothing;
@@ -496,29 +468,20 @@ struct FileCommand {
 
 FileCommand parse_file_command(const std::string& command, const std::vector<std::string>& args, bool takes_surfaces) {
   FileCommand parsed;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw UsageError(command + ": " + arg + " needs a value");
-      return args[++i];
-    };
-    if (arg == "--help" || arg == "-h") {
-      std::cout << usage_text;
-      std::exit(0);
-    } else if (arg == "--report") {
-      parsed.report = value();
-    } else if (arg == "--surface" && takes_surfaces) {
-      parsed.surfaces.push_back(parse_surface(value(), parsed.surfaces.size() + 1));
-    } else if (arg == "--quiet" || arg == "-q") {
-      parsed.quiet = true;
-    } else if (arg.starts_with('-')) {
-      throw UsageError(command + ": unknown option '" + arg + "'");
-    } else if (!parsed.file.empty()) {
-      throw UsageError(command + " takes one mesh file, got '" + parsed.file + "' and '" + arg + "'");
-    } else {
-      parsed.file = arg;
-    }
-  }
+  ArgumentParser parser(command + ": ");
+  parser.help(usage_text);
+  parser.value({"--report"}, [&](const std::string& path) { parsed.report = path; });
+  if (takes_surfaces)
+    parser.value({"--surface"}, [&](const std::string& text) {
+      parsed.surfaces.push_back(meccano::tools::parse_surface_argument(text, parsed.surfaces.size() + 1));
+    });
+  parser.flag({"--quiet", "-q"}, [&] { parsed.quiet = true; });
+  parser.positional([&](const std::string& file) {
+    if (!parsed.file.empty())
+      throw UsageError(command + " takes one mesh file, got '" + parsed.file + "' and '" + file + "'");
+    parsed.file = file;
+  });
+  parser.parse(args);
   if (parsed.file.empty()) throw UsageError(command + " needs a mesh file: meccano-immerse " + command + " FILE.msh");
   if (parsed.report) meccano::require_writable(*parsed.report);  // before the mesh file is read
   return parsed;
@@ -558,15 +521,9 @@ int run_measure(const std::vector<std::string>& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
+  return meccano::tools::run_reporting_errors("meccano-immerse", [&] {
     if (argc > 1 && std::string(argv[1]) == "check") return run_check({argv + 2, argv + argc});
     if (argc > 1 && std::string(argv[1]) == "measure") return run_measure({argv + 2, argv + argc});
     return run(parse_options(argc, argv));
-  } catch (const UsageError& error) {
-    std::cerr << "meccano-immerse: " << error.what() << "\n(see meccano-immerse --help)\n";
-    return 2;
-  } catch (const std::exception& error) {
-    std::cerr << "meccano-immerse: error: " << error.what() << '\n';
-    return 1;
-  }
+  });
 }

@@ -442,71 +442,79 @@ class Flipper {
     return key;
   }
 
-  // The tets around the interior edge (a, b) as a ring T_0..T_{m-1} with ring vertices r_0..r_{m-1},
-  // T_i = (a, b, r_i, r_{i+1}), replaced by the tets (a, r_i, r_k, r_j) and (b, r_i, r_j, r_k) over the
-  // triangles (i < k < j) of the ring polygon's triangulation whose worst tet is best. When (a, b) is an
-  // edge inside S_M, two of the faces around it, (a, b, r_p) and (a, b, r_q), are interface faces: the
-  // triangulation must then hold the diagonal (r_p, r_q), whose faces (a, r_p, r_q) and (b, r_p, r_q)
-  // become the interface there (interface_flip decides whether S_M may take them). Nothing unless the
-  // worst new tet beats the worst removed one, or `floor` if that is lower.
-  std::optional<Retriangulation> edge_removal(TetId t, VertexId a, VertexId b,
-                                              double floor = std::numeric_limits<double>::infinity()) const {
-    const Tet& first = mesh_.tets[t];
-    std::vector<VertexId> ring;
-    for (VertexId v : first)
-      if (v != a && v != b) ring.push_back(v);
-    Retriangulation r;
-    r.removed.push_back(t);
+  // The tets around the edge (a, b) of tet t = T_0, in ring order, with their ring vertices, and the
+  // interface faces around the edge, if it lies inside S_M.
+  struct EdgeRing {
+    std::vector<TetId> tets;         // T_0..T_{m-1}
+    std::vector<VertexId> vertices;  // r_0..r_{m-1}
     FaceTag interface = no_face_tag;
     std::vector<int> on_interface;  // ring indices i of the interface faces (a, b, r_i)
+  };
+
+  // Nothing if the edge is on the mesh's boundary, has more than options_.max_ring tets around it, or
+  // has tagged faces around it other than at most two of one interface.
+  std::optional<EdgeRing> ring_around(TetId t, VertexId a, VertexId b) const {
+    const Tet& first = mesh_.tets[t];
+    EdgeRing around;
+    std::vector<VertexId>& ring = around.vertices;
+    for (VertexId v : first)
+      if (v != a && v != b) ring.push_back(v);
+    around.tets.push_back(t);
     for (TetId current = t;;) {
       // Cross the face of T_i opposite r_i, which holds a, b and r_{i+1}.
-      const int i = static_cast<int>(r.removed.size()) - 1;
+      const int i = static_cast<int>(around.tets.size()) - 1;
       const int face = local_index(mesh_.tets[current], ring[i]);
       if (const FaceTag tag = mesh_.face_tags[current][face]; tag != no_face_tag) {
-        if (!is_interface_tag(tag) || (interface != no_face_tag && tag != interface) || on_interface.size() == 2)
+        if (!is_interface_tag(tag) || (around.interface != no_face_tag && tag != around.interface) ||
+            around.on_interface.size() == 2)
           return std::nullopt;
-        interface = tag;
-        on_interface.push_back(i + 1);
+        around.interface = tag;
+        around.on_interface.push_back(i + 1);
       }
       const TetId next = mesh_.neighbours[current][face];
       if (next == no_tet) return std::nullopt;
       if (next == t) break;
-      if (static_cast<int>(r.removed.size()) == options_.max_ring) return std::nullopt;
+      if (static_cast<int>(around.tets.size()) == options_.max_ring) return std::nullopt;
       const VertexId shared = ring.back();
       for (VertexId v : mesh_.tets[next])
         if (v != a && v != b && v != shared) ring.push_back(v);
-      r.removed.push_back(next);
+      around.tets.push_back(next);
       current = next;
     }
-    const int m = static_cast<int>(r.removed.size());
     ring.pop_back();  // r_m is r_0
-    if (on_interface.size() == 1) return std::nullopt;  // a rim edge
-    if (!same_orientation(mesh_.oriented_tet(t), {a, b, ring[0], ring[1]})) std::swap(a, b);
-    // With an interface, start the ring at r_p (a rotation keeps its order): the diagonal is (r_0, r_q).
-    int q = 0;
-    if (!on_interface.empty()) {
-      const int p = on_interface[0] % m;
-      std::rotate(ring.begin(), ring.begin() + p, ring.end());
-      std::rotate(r.removed.begin(), r.removed.begin() + p, r.removed.end());
-      q = (on_interface[1] % m - p + m) % m;
-      if (q < 2 || q > m - 2) return std::nullopt;  // r_p and r_q adjacent: (r_p, r_q) is not a diagonal
-    }
+    return around;
+  }
 
-    r.worst_removed = std::numeric_limits<double>::infinity();
-    for (TetId removed : r.removed) r.worst_removed = std::min(r.worst_removed, quality(mesh_.oriented_tet(removed)));
+  // With an interface, starts the ring at r_p (a rotation keeps its order): the diagonal is then
+  // (r_0, r_q). Returns q (0 without an interface), nothing if (r_p, r_q) is not a diagonal.
+  static std::optional<int> start_at_interface(EdgeRing& around) {
+    if (around.on_interface.empty()) return 0;
+    const int m = static_cast<int>(around.tets.size());
+    const int p = around.on_interface[0] % m;
+    std::rotate(around.vertices.begin(), around.vertices.begin() + p, around.vertices.end());
+    std::rotate(around.tets.begin(), around.tets.begin() + p, around.tets.end());
+    const int q = (around.on_interface[1] % m - p + m) % m;
+    if (q < 2 || q > m - 2) return std::nullopt;  // r_p and r_q adjacent: (r_p, r_q) is not a diagonal
+    return q;
+  }
 
-    // best[i][j]: the best worst tet over the triangulations of the sub-polygon r_i..r_j; split[i][j] its
-    // apex. The ring closes with r_m = r_0, so that the sub-polygons r_0..r_q and r_q..r_m split the ring
-    // along the diagonal.
-    ring.push_back(ring[0]);
+  // best[i][j]: the best worst tet over the triangulations of the sub-polygon r_i..r_j; split[i][j] its
+  // apex.
+  struct RingTriangulations {
+    std::vector<std::vector<double>> best;
+    std::vector<std::vector<int>> split;
+  };
+
+  // The best triangulations of the `polygons` of the closed ring r_0..r_m, each triangle (i, k, j)
+  // making the tets (a, r_i, r_k, r_j) and (b, r_i, r_j, r_k).
+  RingTriangulations best_triangulations(VertexId a, VertexId b, const std::vector<VertexId>& ring,
+                                         std::span<const std::pair<int, int>> polygons) const {
+    const int m = static_cast<int>(ring.size()) - 1;
     std::vector<std::vector<double>> best(m + 1, std::vector<double>(m + 1, std::numeric_limits<double>::infinity()));
     std::vector<std::vector<int>> split(m + 1, std::vector<int>(m + 1, -1));
     auto triangle_quality = [&](int i, int k, int j) {
       return std::min(new_tet_quality({a, ring[i], ring[k], ring[j]}), new_tet_quality({b, ring[i], ring[j], ring[k]}));
     };
-    const std::vector<std::pair<int, int>> polygons =
-        q == 0 ? std::vector<std::pair<int, int>>{{0, m - 1}} : std::vector<std::pair<int, int>>{{0, q}, {q, m}};
     for (const auto& [lo, hi] : polygons)
       for (int width = 2; width <= hi - lo; ++width)
         for (int i = lo; i + width <= hi; ++i) {
@@ -520,14 +528,13 @@ class Flipper {
             }
           }
         }
-    r.worst_created = std::numeric_limits<double>::infinity();
-    for (const auto& [lo, hi] : polygons) r.worst_created = std::min(r.worst_created, best[lo][hi]);
-    if (!(r.worst_created > std::min(r.worst_removed, floor))) return std::nullopt;
-    if (q != 0) {
-      r.surface_flip = interface_flip(interface_index(interface), a, b, ring[0], ring[q]);
-      if (!r.surface_flip) return std::nullopt;
-      r.tagged_faces = {{sorted_face({a, ring[0], ring[q], b}, 3), interface}, {sorted_face({b, ring[0], ring[q], a}, 3), interface}};
-    }
+    return {std::move(best), std::move(split)};
+  }
+
+  // Adds to r the tets of the triangulations `split` of the `polygons` of the closed ring.
+  static void add_triangulated_tets(Retriangulation& r, VertexId a, VertexId b, const std::vector<VertexId>& ring,
+                                    std::span<const std::pair<int, int>> polygons,
+                                    const std::vector<std::vector<int>>& split) {
     for (const auto& [lo, hi] : polygons) {
       // The tets over the sub-polygon lo..hi lie where T_lo .. T_{hi-1} were: on one side of S_M.
       const TetId side = r.removed[lo];
@@ -544,6 +551,47 @@ class Flipper {
         pending.push_back({k, j});
       }
     }
+  }
+
+  // The tets around the interior edge (a, b) as a ring T_0..T_{m-1} with ring vertices r_0..r_{m-1},
+  // T_i = (a, b, r_i, r_{i+1}), replaced by the tets (a, r_i, r_k, r_j) and (b, r_i, r_j, r_k) over the
+  // triangles (i < k < j) of the ring polygon's triangulation whose worst tet is best. When (a, b) is an
+  // edge inside S_M, two of the faces around it, (a, b, r_p) and (a, b, r_q), are interface faces: the
+  // triangulation must then hold the diagonal (r_p, r_q), whose faces (a, r_p, r_q) and (b, r_p, r_q)
+  // become the interface there (interface_flip decides whether S_M may take them). Nothing unless the
+  // worst new tet beats the worst removed one, or `floor` if that is lower.
+  std::optional<Retriangulation> edge_removal(TetId t, VertexId a, VertexId b,
+                                              double floor = std::numeric_limits<double>::infinity()) const {
+    std::optional<EdgeRing> around = ring_around(t, a, b);
+    if (!around || around->on_interface.size() == 1) return std::nullopt;  // 1: a rim edge
+    std::vector<VertexId>& ring = around->vertices;
+    if (!same_orientation(mesh_.oriented_tet(t), {a, b, ring[0], ring[1]})) std::swap(a, b);
+    const std::optional<int> diagonal_end = start_at_interface(*around);
+    if (!diagonal_end) return std::nullopt;
+    const int q = *diagonal_end;
+
+    Retriangulation r;
+    r.removed = std::move(around->tets);
+    r.worst_removed = std::numeric_limits<double>::infinity();
+    for (TetId removed : r.removed) r.worst_removed = std::min(r.worst_removed, quality(mesh_.oriented_tet(removed)));
+
+    // The ring closes with r_m = r_0, so that the sub-polygons r_0..r_q and r_q..r_m split the ring
+    // along the diagonal.
+    const int m = static_cast<int>(r.removed.size());
+    ring.push_back(ring[0]);
+    const std::vector<std::pair<int, int>> polygons =
+        q == 0 ? std::vector<std::pair<int, int>>{{0, m - 1}} : std::vector<std::pair<int, int>>{{0, q}, {q, m}};
+    const RingTriangulations triangulations = best_triangulations(a, b, ring, polygons);
+    r.worst_created = std::numeric_limits<double>::infinity();
+    for (const auto& [lo, hi] : polygons) r.worst_created = std::min(r.worst_created, triangulations.best[lo][hi]);
+    if (!(r.worst_created > std::min(r.worst_removed, floor))) return std::nullopt;
+    if (q != 0) {
+      const FaceTag interface = around->interface;
+      r.surface_flip = interface_flip(interface_index(interface), a, b, ring[0], ring[q]);
+      if (!r.surface_flip) return std::nullopt;
+      r.tagged_faces = {{sorted_face({a, ring[0], ring[q], b}, 3), interface}, {sorted_face({b, ring[0], ring[q], a}, 3), interface}};
+    }
+    add_triangulated_tets(r, a, b, ring, polygons, triangulations.split);
     return r;
   }
 

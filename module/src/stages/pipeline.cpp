@@ -60,14 +60,72 @@ void check_stage(const TetMesh& mesh, const char* stage) {
   if (!check.ok()) throw MeshingError(std::string("mesh invalid after the ") + stage + " stage: " + check.summary());
 }
 
-InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options,
-                           std::span<const SideRule> side_rules, std::span<const double> resolutions) {
-  InsertionResult result;
-  result.mesh = std::move(mesh);
-  if (static_cast<int>(surfaces.size()) > max_interfaces)
-    throw InputError("at most " + std::to_string(max_interfaces) + " surfaces can be inserted");
+void report_volumetric(const InsertionOptions& options, const std::string& name, const VolumetricStats& stats,
+                       const TetMesh& mesh) {
+  report(options, "volumetric ", name, ": ", stats.refinement_passes, " refinement passes, ",
+         stats.bisections, " bisections, ", stats.tets_intersecting, " tets meet S; grown to ", stats.tets,
+         " tets (", stats.euler_node_stars, " node stars, ", stats.cavity_tets, " cavity tets, ", stats.axis_tets,
+         " axis tets); mesh ", mesh.num_tets(), " tets");
+}
 
-  // Step 1: the volumetric approximation of each surface.
+void report_approximation(const InsertionOptions& options, const SurfaceInsertion& inserted, const TetMesh& mesh) {
+  const auto& h = inserted.healing_stats;
+  report(options, "approximation ", inserted.name, ": side ", h.side > 0 ? "+" : "-", ", ", h.passes,
+         " healing passes; ", h.faces, " faces, ", h.rim_nodes, " rim nodes; extension ", h.extension_faces,
+         ", corbels ", h.corbels, ", reflex corners filled ", h.reflex_corners_filled, " left ", h.reflex_corners_left,
+         ", tets with two faces ",
+         h.tets_with_two_faces, ", triangles with two rim edges ", h.triangles_with_two_rim_edges,
+         ", cross-surface edges ", h.cross_surface_edges, ", dividing edges ", h.dividing_edges, ", chord edges ", h.chord_edges, "; mesh ",
+         mesh.num_tets(), " tets");
+}
+
+void report_projection(const InsertionOptions& options, const SurfaceInsertion& inserted) {
+  const auto& p = inserted.projection.stats;
+  report(options, "projection ", inserted.name, ": ", p.nodes, " nodes (", p.rim_nodes, " on the rim, ",
+         p.creases.nodes, " on ", p.creases.lines, " creases) moved by up to ", p.largest_move, ", now within ",
+         p.largest_distance_after, " of S; ", p.inverted_tets, " tets inverted (smoothing untangles them)");
+}
+
+// The smoothing options, reporting each sweep when the caller follows the progress.
+SmoothingOptions smoothing_options_reporting_sweeps(const InsertionOptions& options) {
+  SmoothingOptions smoothing_options = options.smoothing;
+  if (options.progress)
+    smoothing_options.on_sweep = [&options, caller_on_sweep = options.smoothing.on_sweep](int sweep, const SweepRecord& record) {
+      if (caller_on_sweep) caller_on_sweep(sweep, record);
+      report(options, "smoothing sweep ", sweep, ": ", record.inverted, " tets inverted, quality min ", record.min_quality,
+             " mean ", record.mean_quality,
+             record.target == SmoothingTarget::equilateral ? " towards the equilateral target" : "", ", ",
+             record.nodes_optimised, " nodes optimised");
+    };
+  return smoothing_options;
+}
+
+void report_smoothing(const InsertionOptions& options, const SmoothingStats& smoothing) {
+  const SweepRecord last = smoothing.sweeps.empty() ? SweepRecord{} : smoothing.sweeps.back();
+  report(options, "smoothing: ",
+         smoothing.inner_nodes + smoothing.box_nodes + smoothing.surface_nodes + smoothing.rim_nodes + smoothing.crease_nodes,
+         " free nodes (", smoothing.surface_nodes, " on surfaces, ", smoothing.rim_nodes, " on rims, ",
+         smoothing.crease_nodes, " on creases), ", smoothing.colours,
+         " colours; ", smoothing.inverted_before, " inverted tets before, ", smoothing.inverted_after, " after ",
+         smoothing.sweeps.size(), " sweeps (untangled after ", smoothing.untangling_sweeps,
+         smoothing.fallback_sweep > 0 ? ", towards the equilateral target from sweep " + std::to_string(smoothing.fallback_sweep)
+                                      : std::string(),
+         "); quality min ", last.min_quality, " mean ", last.mean_quality);
+}
+
+void report_improvement(const InsertionOptions& options, const ImprovementOptions& improvement,
+                        const ImprovementStats& improved) {
+  report(options, "improvement: ", improved.passes, " passes over the tets below ", improvement.threshold,
+         " (", improved.tets_below_before, " before, ", improved.tets_below_after, " after), ", improved.nodes_moved,
+         " of ", improved.node_updates, " node updates moved",
+         improvement.topology ? "; " + std::to_string(improved.rounds) + " rounds of flips: " + describe(improved.flips)
+                              : std::string(),
+         "; smallest quality ", improved.min_quality_before, " -> ", improved.min_quality_after, " (equilateral)");
+}
+
+// Step 1: the volumetric approximation of each surface.
+void approximate_volumes(InsertionResult& result, std::span<const TriangleSurface> surfaces,
+                         const InsertionOptions& options, std::span<const double> resolutions) {
   result.surfaces.reserve(surfaces.size());
   for (int index = 0; index < static_cast<int>(surfaces.size()); ++index) {
     const TriangleSurface& surface = surfaces[index];
@@ -82,48 +140,45 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
       return approximate_volume(result.mesh, tree, {inserted.resolution}, inserted.volumetric_stats, earlier);
     });
     inserted.volumetric_seconds = seconds_since(start);
-    const auto& stats = inserted.volumetric_stats;
-    report(options, "volumetric ", surface.name, ": ", stats.refinement_passes, " refinement passes, ",
-           stats.bisections, " bisections, ", stats.tets_intersecting, " tets meet S; grown to ", stats.tets,
-           " tets (", stats.euler_node_stars, " node stars, ", stats.cavity_tets, " cavity tets, ", stats.axis_tets,
-           " axis tets); mesh ", result.mesh.num_tets(), " tets");
+    report_volumetric(options, surface.name, inserted.volumetric_stats, result.mesh);
   }
-  check_stage(result.mesh, "volumetric");
-  if (options.last_stage == Stage::volumetric || surfaces.empty()) return result;
+}
 
-  // Step 2: the surface approximation of each surface, healed. Healing a later surface refines the
-  // mesh near it, which can disturb an earlier S_M close by, so all are checked again and re-healed.
-  std::vector<TriangleBVH> trees;
-  for (const TriangleSurface& surface : surfaces) trees.emplace_back(surface);
+// The V_M of every surface but s.
+std::vector<TetRegion*> other_regions(InsertionResult& result, int s) {
+  std::vector<TetRegion*> regions;
+  for (int other = 0; other < static_cast<int>(result.surfaces.size()); ++other)
+    if (other != s) regions.push_back(&result.surfaces[other].volumetric);
+  return regions;
+}
+
+// The surface approximation of surface s, healed.
+void heal_surface(InsertionResult& result, int s, const TriangleSurface& surface, const TriangleBVH& tree,
+                  const InsertionOptions& options, SideRule side_rule) {
+  SurfaceInsertion& inserted = result.surfaces[s];
+  const auto start = std::chrono::steady_clock::now();
+  SurfaceApproximationOptions approximation = options.approximation;
+  approximation.side_rule = side_rule;
+  inserted.healing_stats = for_surface(s, inserted.name, [&] {
+    return approximate_surface(result.mesh, inserted.volumetric, surface, tree, s, approximation,
+                               other_regions(result, s));
+  });
+  inserted.approximation_seconds += seconds_since(start);
+  report_approximation(options, inserted, result.mesh);
+}
+
+// Step 2: the surface approximation of each surface, healed. Healing a later surface refines the
+// mesh near it, which can disturb an earlier S_M close by, so all are checked again and re-healed.
+void approximate_surfaces(InsertionResult& result, std::span<const TriangleSurface> surfaces,
+                          std::span<const TriangleBVH> trees, const InsertionOptions& options,
+                          std::span<const SideRule> side_rules) {
   const int count = static_cast<int>(surfaces.size());
-  auto other_regions = [&](int s) {
-    std::vector<TetRegion*> regions;
-    for (int other = 0; other < count; ++other)
-      if (other != s) regions.push_back(&result.surfaces[other].volumetric);
-    return regions;
-  };
   for (int round = 0; round < 3; ++round) {
     bool healed_any = false;
     for (int s = 0; s < count; ++s) {
-      SurfaceInsertion& inserted = result.surfaces[s];
-      if (round > 0 && check_surface_approximation(result.mesh, inserted.volumetric, s).healed()) continue;
-      const auto start = std::chrono::steady_clock::now();
-      SurfaceApproximationOptions approximation = options.approximation;
-      approximation.side_rule = side_rules[s];
-      inserted.healing_stats = for_surface(s, inserted.name, [&] {
-        return approximate_surface(result.mesh, inserted.volumetric, surfaces[s], trees[s], s, approximation,
-                                   other_regions(s));
-      });
-      inserted.approximation_seconds += seconds_since(start);
+      if (round > 0 && check_surface_approximation(result.mesh, result.surfaces[s].volumetric, s).healed()) continue;
+      heal_surface(result, s, surfaces[s], trees[s], options, side_rules[s]);
       healed_any = true;
-      const auto& h = inserted.healing_stats;
-      report(options, "approximation ", inserted.name, ": side ", h.side > 0 ? "+" : "-", ", ", h.passes,
-             " healing passes; ", h.faces, " faces, ", h.rim_nodes, " rim nodes; extension ", h.extension_faces,
-             ", corbels ", h.corbels, ", reflex corners filled ", h.reflex_corners_filled, " left ", h.reflex_corners_left,
-             ", tets with two faces ",
-             h.tets_with_two_faces, ", triangles with two rim edges ", h.triangles_with_two_rim_edges,
-             ", cross-surface edges ", h.cross_surface_edges, ", dividing edges ", h.dividing_edges, ", chord edges ", h.chord_edges, "; mesh ",
-             result.mesh.num_tets(), " tets");
     }
     if (!healed_any) break;
   }
@@ -133,71 +188,73 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
       throw SurfaceFailure({s}, "the surface approximation of " + result.surfaces[s].name +
                                     " is disturbed by the other surfaces: " + check.describe());
   }
-  check_stage(result.mesh, "approximation");
-  if (options.last_stage == Stage::approximation) return result;
+}
 
-  // Step 3: every S_M node moves onto its surface. Tets may be tangled until step 4.
-  for (int s = 0; s < count; ++s) {
+// Step 3: every S_M node moves onto its surface. Tets may be tangled until step 4.
+void project_onto_surfaces(InsertionResult& result, std::span<const TriangleSurface> surfaces,
+                           std::span<const TriangleBVH> trees, const InsertionOptions& options) {
+  for (int s = 0; s < static_cast<int>(surfaces.size()); ++s) {
     SurfaceInsertion& inserted = result.surfaces[s];
     const auto start = std::chrono::steady_clock::now();
     inserted.projection = project_onto_surface(result.mesh, inserted.volumetric, s, inserted.healing_stats.side,
                                                surfaces[s], trees[s], options.projection);
     inserted.projection_seconds = seconds_since(start);
-    const auto& p = inserted.projection.stats;
-    report(options, "projection ", inserted.name, ": ", p.nodes, " nodes (", p.rim_nodes, " on the rim, ",
-           p.creases.nodes, " on ", p.creases.lines, " creases) moved by up to ", p.largest_move, ", now within ",
-           p.largest_distance_after, " of S; ", p.inverted_tets, " tets inverted (smoothing untangles them)");
+    report_projection(options, inserted);
   }
+}
+
+// Step 4: untangling and smoothing, every surface's nodes moving within it.
+void untangle_and_smooth(InsertionResult& result, std::span<SurfaceProjection* const> projections, const InsertionOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  result.smoothing = smooth_mesh(result.mesh, projections, smoothing_options_reporting_sweeps(options));
+  result.smoothing_seconds = seconds_since(start);
+  report_smoothing(options, result.smoothing);
+}
+
+void lift_worst_tets(InsertionResult& result, std::span<SurfaceProjection* const> projections, const InsertionOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  ImprovementOptions improvement = options.improvement;
+  improvement.topology = options.improve == Improvement::topology;
+  if (options.progress) improvement.progress = options.progress;
+  std::vector<TetRegion*> regions;
+  for (SurfaceInsertion& inserted : result.surfaces) regions.push_back(&inserted.volumetric);
+  const ImprovementStats& improved = result.improvement.emplace(
+      improve_worst_tets(result.mesh, projections, improvement, options.smoothing, regions));
+  result.improvement_seconds = seconds_since(started);
+  report_improvement(options, improvement, improved);
+}
+
+InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options,
+                           std::span<const SideRule> side_rules, std::span<const double> resolutions) {
+  InsertionResult result;
+  result.mesh = std::move(mesh);
+  if (static_cast<int>(surfaces.size()) > max_interfaces)
+    throw InputError("at most " + std::to_string(max_interfaces) + " surfaces can be inserted");
+
+  approximate_volumes(result, surfaces, options, resolutions);
+  check_stage(result.mesh, "volumetric");
+  if (options.last_stage == Stage::volumetric || surfaces.empty()) return result;
+
+  std::vector<TriangleBVH> trees;
+  for (const TriangleSurface& surface : surfaces) trees.emplace_back(surface);
+  approximate_surfaces(result, surfaces, trees, options, side_rules);
+  check_stage(result.mesh, "approximation");
+  if (options.last_stage == Stage::approximation) return result;
+
+  project_onto_surfaces(result, surfaces, trees, options);
   const auto check = verify_mesh(result.mesh, {.physical = false});
   if (!check.ok()) throw MeshingError("mesh invalid after the projection stage: " + check.summary());
   result.quality_before_smoothing = summarize_quality(result.mesh);
   if (options.last_stage == Stage::projection) return result;
 
-  // Step 4: untangling and smoothing, every surface's nodes moving within it.
-  const auto start = std::chrono::steady_clock::now();
   std::vector<SurfaceProjection*> projections;
   for (SurfaceInsertion& inserted : result.surfaces) projections.push_back(&inserted.projection);
-  SmoothingOptions smoothing_options = options.smoothing;
-  if (options.progress)
-    smoothing_options.on_sweep = [&options, caller_on_sweep = options.smoothing.on_sweep](int sweep, const SweepRecord& record) {
-      if (caller_on_sweep) caller_on_sweep(sweep, record);
-      report(options, "smoothing sweep ", sweep, ": ", record.inverted, " tets inverted, quality min ", record.min_quality,
-             " mean ", record.mean_quality,
-             record.target == SmoothingTarget::equilateral ? " towards the equilateral target" : "", ", ",
-             record.nodes_optimised, " nodes optimised");
-    };
-  result.smoothing = smooth_mesh(result.mesh, projections, smoothing_options);
-  result.smoothing_seconds = seconds_since(start);
-  const SmoothingStats& smoothing = result.smoothing;
-  const SweepRecord last = smoothing.sweeps.empty() ? SweepRecord{} : smoothing.sweeps.back();
-  report(options, "smoothing: ",
-         smoothing.inner_nodes + smoothing.box_nodes + smoothing.surface_nodes + smoothing.rim_nodes + smoothing.crease_nodes,
-         " free nodes (", smoothing.surface_nodes, " on surfaces, ", smoothing.rim_nodes, " on rims, ",
-         smoothing.crease_nodes, " on creases), ", smoothing.colours,
-         " colours; ", smoothing.inverted_before, " inverted tets before, ", smoothing.inverted_after, " after ",
-         smoothing.sweeps.size(), " sweeps (untangled after ", smoothing.untangling_sweeps,
-         smoothing.fallback_sweep > 0 ? ", towards the equilateral target from sweep " + std::to_string(smoothing.fallback_sweep)
-                                      : std::string(),
-         "); quality min ", last.min_quality, " mean ", last.mean_quality);
-  if (!smoothing.untangled()) return result;  // the caller may retry, or reports the failure
+  untangle_and_smooth(result, projections, options);
+  if (!result.smoothing.untangled()) return result;  // the caller may retry, or reports the failure
   check_stage(result.mesh, "smoothing");
 
   if (options.improve != Improvement::none) {
-    const auto started = std::chrono::steady_clock::now();
-    ImprovementOptions improvement = options.improvement;
-    improvement.topology = options.improve == Improvement::topology;
-    if (options.progress) improvement.progress = options.progress;
-    std::vector<TetRegion*> regions;
-    for (SurfaceInsertion& inserted : result.surfaces) regions.push_back(&inserted.volumetric);
-    const ImprovementStats& improved = result.improvement.emplace(
-        improve_worst_tets(result.mesh, projections, improvement, options.smoothing, regions));
-    result.improvement_seconds = seconds_since(started);
-    report(options, "improvement: ", improved.passes, " passes over the tets below ", improvement.threshold,
-           " (", improved.tets_below_before, " before, ", improved.tets_below_after, " after), ", improved.nodes_moved,
-           " of ", improved.node_updates, " node updates moved",
-           improvement.topology ? "; " + std::to_string(improved.rounds) + " rounds of flips: " + describe(improved.flips)
-                                : std::string(),
-           "; smallest quality ", improved.min_quality_before, " -> ", improved.min_quality_after, " (equilateral)");
+    lift_worst_tets(result, projections, options);
     check_stage(result.mesh, "improvement");
   }
   result.quality_after_smoothing = summarize_quality(result.mesh);

@@ -265,6 +265,28 @@ class Smoother {
   bool optimise(VertexId v);
   void store(VertexId v, const Placement& at);
   SweepRecord measure() const;
+
+  // What run() keeps from one sweep to the next.
+  struct SweepState {
+    explicit SweepState(std::size_t vertices) : last_moved(vertices, 0), last_optimised(vertices, -1) {}
+    void look_at_all_again() { std::fill(last_optimised.begin(), last_optimised.end(), -1); }
+    // A node needs another look only if it or a node of its star moved since it was last optimised.
+    std::vector<std::int64_t> last_moved, last_optimised;
+    std::int64_t epoch = 0;
+    int clean_sweeps = 0;
+    std::int64_t fewest_inverted = std::numeric_limits<std::int64_t>::max();
+    int stalled_sweeps = 0;  // since ε was last raised or the fewest inverted count lowered
+    int sweeps_since_fewest = 0;
+  };
+  void count_free_nodes(std::span<const VertexId> nodes);
+  void collect_active_tets(std::span<const VertexId> nodes);
+  void switch_target(SmoothingTarget target, SweepState& state);
+  void fall_back_if_stalled(int sweep, SweepState& state);
+  std::int64_t optimise_colours(const std::vector<std::vector<VertexId>>& colours, SweepState& state);
+  SweepRecord record_sweep(std::int64_t optimised, std::chrono::steady_clock::time_point start) const;
+  std::optional<double> comparable_objective() const;
+  bool untangling_stuck(const SweepRecord& record, SweepState& state);
+  bool smoothing_done(int sweep, const SweepRecord& record, std::optional<double> previous_objective, SweepState& state);
   // The exponent p of Σ η*^p: the paper's 1 while tangled, options_.power once a sweep ends untangled;
   // the improvement's own.
   double power() const { return improving_ ? improving_->power : tangled_ ? 1.0 : options_.power; }
@@ -650,8 +672,8 @@ SweepRecord Smoother::measure() const {
   return record;
 }
 
-SmoothingStats Smoother::run() {
-  const std::vector<VertexId> nodes = free_nodes();
+// Counts the free nodes by how they may move, for the stats.
+void Smoother::count_free_nodes(std::span<const VertexId> nodes) {
   for (VertexId v : nodes) {
     switch (freedom_[v].kind) {
       case Freedom::space: ++stats_.inner_nodes; break;
@@ -662,94 +684,129 @@ SmoothingStats Smoother::run() {
       case Freedom::fixed: break;
     }
   }
+}
+
+// The tets of the free nodes' stars: those the sweeps measure.
+void Smoother::collect_active_tets(std::span<const VertexId> nodes) {
   std::vector<std::uint8_t> active(mesh_.tets.size(), 0);
   for (VertexId v : nodes)
     for (TetId t : stars_.of(v)) active[t] = 1;
   for (TetId t = 0; t < mesh_.num_tets(); ++t)
     if (active[t]) active_tets_.push_back(t);
   stats_.active_tets = static_cast<std::int64_t>(active_tets_.size());
+}
+
+// A new target changes every node's objective: all of them get another look.
+void Smoother::switch_target(SmoothingTarget target, SweepState& state) {
+  aim_at(target);
+  state.look_at_all_again();
+}
+
+void Smoother::fall_back_if_stalled(int sweep, SweepState& state) {
+  if (tangled_ && target_ == SmoothingTarget::meccano && options_.fallback_sweeps > 0 &&
+      (sweep > options_.fallback_sweeps || returned_from_fallback_)) {
+    // Untangling towards the meccano target stalled (or its smoothing tangled the mesh again).
+    switch_target(SmoothingTarget::equilateral, state);
+    if (stats_.fallback_sweep == 0) stats_.fallback_sweep = sweep;
+    untangling_epsilon_ = initial_untangling_epsilon;
+    state.fewest_inverted = std::numeric_limits<std::int64_t>::max();
+    state.stalled_sweeps = state.sweeps_since_fewest = 0;
+  }
+}
+
+// Optimises the nodes that need another look, one colour after the other, the nodes of a colour in
+// parallel. How many were optimised.
+std::int64_t Smoother::optimise_colours(const std::vector<std::vector<VertexId>>& colours, SweepState& state) {
+  std::vector<std::int64_t>& last_moved = state.last_moved;
+  std::vector<std::int64_t>& last_optimised = state.last_optimised;
+  std::int64_t optimised = 0;
+  for (const auto& group : colours) {
+    const std::int64_t epoch = ++state.epoch;
+    const auto size = static_cast<std::int64_t>(group.size());
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : optimised)
+    for (std::int64_t i = 0; i < size; ++i) {
+      const VertexId v = group[i];
+      std::int64_t latest = last_moved[v];
+      for_each_star_vertex(v, [&](VertexId w) { latest = std::max(latest, last_moved[w]); });
+      if (latest < last_optimised[v]) continue;
+      last_optimised[v] = epoch;
+      ++optimised;
+      if (optimise(v)) last_moved[v] = epoch;
+    }
+  }
+  return optimised;
+}
+
+// The record of the sweep begun at `start`, measured now.
+SweepRecord Smoother::record_sweep(std::int64_t optimised, std::chrono::steady_clock::time_point start) const {
+  SweepRecord record = measure();
+  record.nodes_optimised = optimised;
+  record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  record.power = power();
+  record.target = target_;
+  return record;
+}
+
+// The last sweep's objective, if the next sweep's can be compared with it: both used the same power and W.
+std::optional<double> Smoother::comparable_objective() const {
+  const bool comparable = !stats_.sweeps.empty() && stats_.sweeps.back().power == power() &&
+                          stats_.sweeps.back().target == target_ && stats_.sweeps.back().inverted == 0;
+  return comparable ? std::optional<double>(stats_.sweeps.back().objective) : std::nullopt;
+}
+
+// After a sweep that left tets inverted: whether untangling is stuck, and the smoothing gives up.
+bool Smoother::untangling_stuck(const SweepRecord& record, SweepState& state) {
+  // Stalled untangling: the tangled stars sit in local minima of a steep objective. A larger ε
+  // (a larger δ where stars are tangled) flattens it so that nodes can pass through.
+  if (record.inverted < state.fewest_inverted) {
+    state.fewest_inverted = record.inverted;
+    state.stalled_sweeps = state.sweeps_since_fewest = 0;
+  } else if (++state.stalled_sweeps >= 3 && untangling_epsilon_ < 1.0) {
+    untangling_epsilon_ *= 10.0;
+    state.stalled_sweeps = 0;
+  }
+  const bool fallback_pending =
+      target_ == SmoothingTarget::meccano && options_.fallback_sweeps > 0 && stats_.fallback_sweep == 0;
+  return ++state.sweeps_since_fewest > options_.stalled_sweeps && !fallback_pending;
+}
+
+// After a sweep that left no tet inverted: whether the smoothing is done.
+bool Smoother::smoothing_done(int sweep, const SweepRecord& record, std::optional<double> previous_objective,
+                              SweepState& state) {
+  // A raised ε would keep δ large on valid stars, and their barrier soft: smoothing could tangle again.
+  untangling_epsilon_ = initial_untangling_epsilon;
+  // The objective's power changes with the first untangled sweep: every node gets another look.
+  if (state.clean_sweeps == 0) state.look_at_all_again();
+  if (state.clean_sweeps++ == 0 && stats_.inverted_before > 0) stats_.untangling_sweeps = sweep;
+  if (state.clean_sweeps >= options_.smoothing_sweeps || record.nodes_optimised == 0) return true;
+  if (target_ != options_.target && !returned_from_fallback_) {
+    switch_target(options_.target, state);  // untangled by the fallback: smooth towards the chosen target
+    returned_from_fallback_ = true;
+    return false;
+  }
+  return previous_objective &&
+         *previous_objective - record.objective <= options_.tolerance * *previous_objective;
+}
+
+SmoothingStats Smoother::run() {
+  const std::vector<VertexId> nodes = free_nodes();
+  count_free_nodes(nodes);
+  collect_active_tets(nodes);
   stats_.inverted_before = count_inverted(mesh_);
 
   const auto colours = colour(nodes);
   stats_.colours = static_cast<int>(colours.size());
-  // A node needs another look only if it or a node of its star moved since it was last optimised.
-  std::vector<std::int64_t> last_moved(mesh_.points.size(), 0), last_optimised(mesh_.points.size(), -1);
-  std::int64_t epoch = 0;
-  int clean_sweeps = 0;
-  std::int64_t fewest_inverted = std::numeric_limits<std::int64_t>::max();
-  int stalled_sweeps = 0;     // since ε was last raised or the fewest inverted count lowered
-  int sweeps_since_fewest = 0;
-  // A new target changes every node's objective: all of them get another look.
-  auto switch_target = [&](SmoothingTarget target) {
-    aim_at(target);
-    std::fill(last_optimised.begin(), last_optimised.end(), -1);
-  };
+  SweepState state(mesh_.points.size());
   for (int sweep = 1; sweep <= options_.max_sweeps; ++sweep) {
-    if (tangled_ && target_ == SmoothingTarget::meccano && options_.fallback_sweeps > 0 &&
-        (sweep > options_.fallback_sweeps || returned_from_fallback_)) {
-      // Untangling towards the meccano target stalled (or its smoothing tangled the mesh again).
-      switch_target(SmoothingTarget::equilateral);
-      if (stats_.fallback_sweep == 0) stats_.fallback_sweep = sweep;
-      untangling_epsilon_ = initial_untangling_epsilon;
-      fewest_inverted = std::numeric_limits<std::int64_t>::max();
-      stalled_sweeps = sweeps_since_fewest = 0;
-    }
+    fall_back_if_stalled(sweep, state);
     const auto start = std::chrono::steady_clock::now();
-    std::int64_t optimised = 0;
-    for (const auto& group : colours) {
-      ++epoch;
-      const auto size = static_cast<std::int64_t>(group.size());
-#pragma omp parallel for schedule(dynamic, 64) reduction(+ : optimised)
-      for (std::int64_t i = 0; i < size; ++i) {
-        const VertexId v = group[i];
-        std::int64_t latest = last_moved[v];
-        for_each_star_vertex(v, [&](VertexId w) { latest = std::max(latest, last_moved[w]); });
-        if (latest < last_optimised[v]) continue;
-        last_optimised[v] = epoch;
-        ++optimised;
-        if (optimise(v)) last_moved[v] = epoch;
-      }
-    }
-    SweepRecord record = measure();
-    record.nodes_optimised = optimised;
-    record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    record.power = power();
-    record.target = target_;
-    // The objective can only be compared with the previous sweep's if both used the same power and W.
-    const bool comparable = !stats_.sweeps.empty() && stats_.sweeps.back().power == power() &&
-                            stats_.sweeps.back().target == target_ && stats_.sweeps.back().inverted == 0;
-    const double previous_objective = comparable ? stats_.sweeps.back().objective : infinity;
+    const SweepRecord record = record_sweep(optimise_colours(colours, state), start);
+    const std::optional<double> previous_objective = comparable_objective();
     stats_.sweeps.push_back(record);
     if (options_.on_sweep) options_.on_sweep(sweep, record);
     // Untangling uses the paper's sum; once a sweep ends untangled, the next ones weigh bad tets more.
     tangled_ = record.inverted > 0;
-    if (record.inverted > 0) {
-      // Stalled untangling: the tangled stars sit in local minima of a steep objective. A larger ε
-      // (a larger δ where stars are tangled) flattens it so that nodes can pass through.
-      if (record.inverted < fewest_inverted) {
-        fewest_inverted = record.inverted;
-        stalled_sweeps = sweeps_since_fewest = 0;
-      } else if (++stalled_sweeps >= 3 && untangling_epsilon_ < 1.0) {
-        untangling_epsilon_ *= 10.0;
-        stalled_sweeps = 0;
-      }
-      const bool fallback_pending =
-          target_ == SmoothingTarget::meccano && options_.fallback_sweeps > 0 && stats_.fallback_sweep == 0;
-      if (++sweeps_since_fewest > options_.stalled_sweeps && !fallback_pending) break;  // stuck: give up
-      continue;
-    }
-    // A raised ε would keep δ large on valid stars, and their barrier soft: smoothing could tangle again.
-    untangling_epsilon_ = initial_untangling_epsilon;
-    // The objective's power changes with the first untangled sweep: every node gets another look.
-    if (clean_sweeps == 0) std::fill(last_optimised.begin(), last_optimised.end(), -1);
-    if (clean_sweeps++ == 0 && stats_.inverted_before > 0) stats_.untangling_sweeps = sweep;
-    if (clean_sweeps >= options_.smoothing_sweeps || optimised == 0) break;
-    if (target_ != options_.target && !returned_from_fallback_) {
-      switch_target(options_.target);  // untangled by the fallback: smooth towards the chosen target
-      returned_from_fallback_ = true;
-      continue;
-    }
-    if (comparable && previous_objective - record.objective <= options_.tolerance * previous_objective) break;
+    if (tangled_ ? untangling_stuck(record, state) : smoothing_done(sweep, record, previous_objective, state)) break;
   }
   stats_.inverted_after = count_inverted(mesh_);
   return stats_;

@@ -248,75 +248,107 @@ TetRegion approximate_volume(TetMesh& mesh, const TriangleBVH& surface, const Vo
   return region;
 }
 
-void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& options, VolumetricStats& stats,
-                    std::vector<TetRegion*> other_regions, const TriangleBVH* surface) {
-  const ChildCallback follow_others = region_follows_children(std::move(other_regions));
-  // Steps 2 and 3: grow into a ball with axis-parallel boundary faces. A tet the growth wants that is
-  // coarser than V_M's level, or (given S) has a node beyond the reach, is bisected instead of added:
-  // adding coarse tets would pull far-away, coarse parts of the mesh into V_M (each brings new oblique
-  // faces and pinched nodes further out), and far nodes would become nodes of S_M far from S. The
-  // reach is at least the diagonal of the level's cubes, which the axis-parallel growth completes:
-  // with l_r alone, a level finer than the cubes' (tets shorter than l_r in cubes wider than it)
-  // bisected its way out to l_r / 16 all around S, for up to 3 times the tets and tangles that took
-  // five times the smoothing (doc/benchmarks.md, "Predictable cost").
-  // Where the growth must cross the offset at the reach, bisection alone never ends: a tet straddling
-  // it keeps a child that straddles it, and the front refines without limit. So a tet 16 times finer
-  // than V_M's is added when its nodes are within the band 1.125 × reach of S, and the growth fails if
-  // it needs one that reaches beyond the band.
-  const int target_level = level_for_resolution(mesh.meccano, options.resolution);
-  stats.reach = growth_reach(mesh.meccano, options.resolution);
-  const double reach = stats.reach;
-  const double band = reach * growth_band;
-  std::vector<double> distance_to_surface;  // per vertex; NaN: not computed yet
-  auto farthest_node = [&](TetId t) {
-    distance_to_surface.resize(mesh.points.size(), std::numeric_limits<double>::quiet_NaN());
-    double farthest = 0.0;
-    for (VertexId v : mesh.tets[t]) {
-      if (std::isnan(distance_to_surface[v]))
-        distance_to_surface[v] = std::sqrt(surface->closest_point(mesh.points[v]).squared_distance);
-      farthest = std::max(farthest, distance_to_surface[v]);
-    }
-    return farthest;
-  };
-  auto grow = [&](const std::vector<TetId>& wanted) -> std::int64_t {
+namespace {
+
+// The growth of V_M into a ball (grow_into_ball). A tet the growth wants that is coarser than V_M's
+// level, or (given S) has a node beyond the reach, is bisected instead of added:
+// adding coarse tets would pull far-away, coarse parts of the mesh into V_M (each brings new oblique
+// faces and pinched nodes further out), and far nodes would become nodes of S_M far from S. The
+// reach is at least the diagonal of the level's cubes, which the axis-parallel growth completes:
+// with l_r alone, a level finer than the cubes' (tets shorter than l_r in cubes wider than it)
+// bisected its way out to l_r / 16 all around S, for up to 3 times the tets and tangles that took
+// five times the smoothing (doc/benchmarks.md, "Predictable cost").
+// Where the growth must cross the offset at the reach, bisection alone never ends: a tet straddling
+// it keeps a child that straddles it, and the front refines without limit. So a tet 16 times finer
+// than V_M's is added when its nodes are within the band 1.125 × reach of S, and the growth fails if
+// it needs one that reaches beyond the band.
+class BallGrowth {
+ public:
+  BallGrowth(TetMesh& mesh, TetRegion& region, const VolumetricOptions& options, VolumetricStats& stats,
+             std::vector<TetRegion*> other_regions, const TriangleBVH* surface)
+      : mesh_(mesh), region_(region), stats_(stats), surface_(surface),
+        follow_others_(region_follows_children(std::move(other_regions))),
+        target_level_(level_for_resolution(mesh.meccano, options.resolution)),
+        reach_(growth_reach(mesh.meccano, options.resolution)), band_(reach_ * growth_band) {
+    stats.reach = reach_;
+  }
+
+  // Adds the `wanted` tets or bisects them; how many it added or bisected.
+  std::int64_t grow(const std::vector<TetId>& wanted) {
     std::vector<TetId> coarse;
     std::int64_t added = 0;
     for (TetId t : wanted) {
-      if (region[t]) continue;
-      const int level = mesh.level(t);
-      const double farthest = surface && level >= target_level ? farthest_node(t) : 0.0;
-      if (level < target_level || (farthest >= reach && level < target_level + finest_growth_levels)) {
+      if (region_[t]) continue;
+      const int level = mesh_.level(t);
+      const double farthest = surface_ && level >= target_level_ ? farthest_node(t) : 0.0;
+      if (level < target_level_ || (farthest >= reach_ && level < target_level_ + finest_growth_levels)) {
         coarse.push_back(t);
         continue;
       }
-      if (farthest >= band) {
-        const Eigen::Vector3d at = mesh.points[mesh.tets[t][0]];
-        throw MeshingError("the volumetric approximation cannot be grown into a ball within reach of the surface "
-                           "near (" + std::to_string(at.x()) + ", " + std::to_string(at.y()) + ", " +
-                           std::to_string(at.z()) + "): the ball must reach " + std::to_string(farthest / reach) +
-                           " times the reach " + std::to_string(reach) +
-                           " from it; a smaller l_r resolves this part of the surface");
-      }
-      stats.band_tets += farthest >= reach;
-      region[t] = 1;
+      if (farthest >= band_) throw beyond_band(t, farthest);
+      stats_.band_tets += farthest >= reach_;
+      region_[t] = 1;
       ++added;
     }
-    if (!coarse.empty()) {
-      std::sort(coarse.begin(), coarse.end());
-      coarse.erase(std::unique(coarse.begin(), coarse.end()), coarse.end());
-      stats.bisections += refine_marked(mesh, coarse, [&](TetId parent, TetId child) {
-        follow_others(parent, child);
-        region.push_back(region[parent]);
-      });
-      ++stats.growth_refinements;
-    }
+    if (!coarse.empty()) bisect(coarse);
     return added + static_cast<std::int64_t>(coarse.size());
-  };
+  }
+
+ private:
+  // The distance from tet t's farthest node to S.
+  double farthest_node(TetId t) {
+    distance_to_surface_.resize(mesh_.points.size(), std::numeric_limits<double>::quiet_NaN());
+    double farthest = 0.0;
+    for (VertexId v : mesh_.tets[t]) {
+      if (std::isnan(distance_to_surface_[v]))
+        distance_to_surface_[v] = std::sqrt(surface_->closest_point(mesh_.points[v]).squared_distance);
+      farthest = std::max(farthest, distance_to_surface_[v]);
+    }
+    return farthest;
+  }
+
+  void bisect(std::vector<TetId>& coarse) {
+    std::sort(coarse.begin(), coarse.end());
+    coarse.erase(std::unique(coarse.begin(), coarse.end()), coarse.end());
+    stats_.bisections += refine_marked(mesh_, coarse, [&](TetId parent, TetId child) {
+      follow_others_(parent, child);
+      region_.push_back(region_[parent]);
+    });
+    ++stats_.growth_refinements;
+  }
+
+  // The failure of a growth that wants tet t, whose farthest node lies beyond the band.
+  MeshingError beyond_band(TetId t, double farthest) const {
+    const Eigen::Vector3d at = mesh_.points[mesh_.tets[t][0]];
+    return MeshingError("the volumetric approximation cannot be grown into a ball within reach of the surface "
+                        "near (" + std::to_string(at.x()) + ", " + std::to_string(at.y()) + ", " +
+                        std::to_string(at.z()) + "): the ball must reach " + std::to_string(farthest / reach_) +
+                        " times the reach " + std::to_string(reach_) +
+                        " from it; a smaller l_r resolves this part of the surface");
+  }
+
+  TetMesh& mesh_;
+  TetRegion& region_;
+  VolumetricStats& stats_;
+  const TriangleBVH* surface_;
+  const ChildCallback follow_others_;
+  const int target_level_;
+  const double reach_;
+  const double band_;
+  std::vector<double> distance_to_surface_;  // per vertex; NaN: not computed yet
+};
+
+}  // namespace
+
+void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& options, VolumetricStats& stats,
+                    std::vector<TetRegion*> other_regions, const TriangleBVH* surface) {
+  // Steps 2 and 3: grow into a ball with axis-parallel boundary faces.
+  BallGrowth growth(mesh, region, options, stats, std::move(other_regions), surface);
   // Cheapest checks first: the link test visits every boundary node, so it runs once the boundary is
   // axis-parallel and free of cavities.
   for (stats.growth_passes = 1; stats.growth_passes <= options.max_growth_passes; ++stats.growth_passes) {
     if (const auto across = tets_across_oblique_faces(mesh, region); !across.empty()) {
-      stats.axis_tets += grow(across);
+      stats.axis_tets += growth.grow(across);
       continue;
     }
     if (const auto n = fill_cavities(mesh, region); n > 0) {
@@ -326,7 +358,7 @@ void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& o
     std::int64_t bad_nodes = 0;
     if (const auto stars = stars_of_non_disk_nodes(mesh, region, bad_nodes); bad_nodes > 0) {
       stats.euler_node_stars += bad_nodes;
-      grow(stars);
+      growth.grow(stars);
       continue;
     }
     if (boundary_topology(mesh, region).is_ball()) {  // links were just found to be disks
@@ -335,7 +367,7 @@ void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& o
     }
     // Every link is a disk but the boundary is not a sphere (a handle): thicken V_M by one layer.
     ++stats.thickening_layers;
-    grow(layer_around(mesh, region));
+    growth.grow(layer_around(mesh, region));
   }
   throw MeshingError("the volumetric approximation could not be grown into a topological ball in " +
                      std::to_string(options.max_growth_passes) + " passes");

@@ -227,48 +227,27 @@ class MeshFileChecker {
     detail::TopologyScratch scratch;
     std::vector<VertexId> vertices;
     const detail::TriangleTopology topology = detail::triangle_topology(triangles, scratch, &vertices);
-    // An edge of a consistently oriented surface is run once in each direction; the boundary edges (in
-    // one triangle) form the boundary loops.
+    // An edge of a consistently oriented surface is run once in each direction.
     std::vector<std::pair<VertexId, VertexId>> directed;
-    std::vector<detail::Edge> undirected;
     for (const auto& t : triangles)
-      for (int k = 0; k < 3; ++k) {
-        directed.push_back({t[k], t[(k + 1) % 3]});
-        undirected.push_back(detail::make_edge(t[k], t[(k + 1) % 3]));
-      }
+      for (int k = 0; k < 3; ++k) directed.push_back({t[k], t[(k + 1) % 3]});
     std::ranges::sort(directed);
-    std::ranges::sort(undirected);
     std::int64_t flipped = 0;
     for (std::size_t i = 1; i < directed.size(); ++i) flipped += directed[i] == directed[i - 1];
-    detail::UnionFind loops(vertices.size());
-    std::vector<char> on_boundary(vertices.size(), 0);
-    auto index = [&](VertexId v) { return static_cast<std::size_t>(std::ranges::lower_bound(vertices, v) - vertices.begin()); };
-    for (std::size_t i = 0; i < undirected.size();) {
-      std::size_t j = i + 1;
-      while (j < undirected.size() && undirected[j] == undirected[i]) ++j;
-      if (j - i == 1) {
-        const auto [a, b] = undirected[i];
-        loops.join(index(a), index(b));
-        on_boundary[index(a)] = on_boundary[index(b)] = 1;
-      }
-      i = j;
-    }
-    std::int64_t boundary_loops = 0;
-    for (std::size_t v = 0; v < vertices.size(); ++v) boundary_loops += on_boundary[v] && loops.find(v) == v;
 
     if (triangles.empty()) problem(check, "the group has no triangles");
     if (topology.components > 1) problem(check, topology.components, " connected components (a disk has one)");
     if (topology.overloaded_edges > 0) problem(check, topology.overloaded_edges, " edges in more than two triangles");
     if (topology.pinched_vertices > 0) problem(check, topology.pinched_vertices, " pinched vertices");
     if (topology.euler() != 1) problem(check, "Euler characteristic ", topology.euler(), " (a disk has 1)");
-    if (boundary_loops != 1) problem(check, boundary_loops, " boundary loops (a disk has one)");
+    if (topology.boundary_loops != 1) problem(check, topology.boundary_loops, " boundary loops (a disk has one)");
     if (flipped > 0) problem(check, flipped, " edges run twice in the same direction (inconsistent orientation)");
     // Not a defect of the mesh, but a fault solver that splits the interface's nodes needs a node off the
     // interface in every tet: counted, not failed (a coarse mesh that keeps the surface may have some).
     const auto on_interface = [&](int node) { return std::ranges::binary_search(vertices, node); };
     const auto lying_on = std::ranges::count_if(mesh_.tets, [&](const std::array<int, 4>& tet) { return std::ranges::all_of(tet, on_interface); });
     check.summary = std::to_string(triangles.size()) + " triangles, Euler characteristic " +
-                    std::to_string(topology.euler()) + ", " + std::to_string(boundary_loops) + " boundary loop(s)";
+                    std::to_string(topology.euler()) + ", " + std::to_string(topology.boundary_loops) + " boundary loop(s)";
     if (lying_on > 0) check.summary += ", " + std::to_string(lying_on) + " tets with all four nodes on it";
     return check;
   }

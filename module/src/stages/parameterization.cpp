@@ -3,6 +3,8 @@
 #include <meccano/error.hpp>
 #include <meccano/geometry/geometry.hpp>
 
+#include "mesh/topology_helpers.hpp"
+
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -134,8 +136,8 @@ Connectivity connect(DiskView disk) {
                        " has " + std::to_string(c.rim.size()) + " of the " + std::to_string(rim_edges) +
                        " rim edges");
   // A disk has Euler characteristic 1; one rim loop with a handle or a closed component does not.
-  const long long edges = (3LL * triangle_count + rim_edges) / 2;
-  const long long euler = n - edges + triangle_count;
+  detail::TopologyScratch scratch;
+  const std::int64_t euler = detail::triangle_topology(disk.triangles, scratch).euler();
   if (euler != 1)
     throw MeshingError("parameterization: not a disk: Euler characteristic " + std::to_string(euler) +
                        " (a handle, or more than one component)");

@@ -426,17 +426,7 @@ void check_disk(const TetMesh& mesh, const Interface& s, SurfaceApproximationChe
   c.non_manifold_edges = topology.overloaded_edges;
   c.pinched_nodes = topology.pinched_vertices;
   c.euler = topology.euler();
-  // Rim loops: components of the rim edges.
-  std::vector<VertexId> rim_nodes;
-  for (const Edge& e : s.rim_edges) rim_nodes.insert(rim_nodes.end(), {e.first, e.second});
-  std::sort(rim_nodes.begin(), rim_nodes.end());
-  rim_nodes.erase(std::unique(rim_nodes.begin(), rim_nodes.end()), rim_nodes.end());
-  UnionFind loops(rim_nodes.size());
-  auto index = [&](VertexId v) {
-    return static_cast<std::size_t>(std::lower_bound(rim_nodes.begin(), rim_nodes.end(), v) - rim_nodes.begin());
-  };
-  for (const Edge& e : s.rim_edges) loops.join(index(e.first), index(e.second));
-  for (std::size_t i = 0; i < rim_nodes.size(); ++i) c.rim_loops += loops.find(i) == i;
+  c.rim_loops = topology.boundary_loops;
   for (const Edge& e : s.rim_edges) c.oblique_rim_edges += !edge_is_axis_parallel(mesh, e.first, e.second);
 }
 

@@ -23,12 +23,6 @@ CheckResult named(std::string name) {
   return check;
 }
 
-struct TetFace {
-  Face key;  // sorted
-  int tet;
-  int local_face;
-};
-
 class MeshFileChecker {
  public:
   MeshFileChecker(const MshMesh& mesh, int max_reported) : mesh_(mesh), max_reported_(max_reported) {
@@ -38,14 +32,6 @@ class MeshFileChecker {
       hi_ = hi_.cwiseMax(p);
     }
     tolerance_ = 1e-9 * (hi_ - lo_).maxCoeff();
-    for (int t = 0; t < static_cast<int>(mesh.tets.size()); ++t)
-      for (int f = 0; f < 4; ++f) {
-        Face key;
-        for (int k = 0; k < 3; ++k) key[k] = mesh.tets[t][face_vertices[f][k]];
-        std::sort(key.begin(), key.end());
-        faces_.push_back({key, t, f});
-      }
-    std::sort(faces_.begin(), faces_.end(), [](const TetFace& a, const TetFace& b) { return a.key < b.key; });
   }
 
   MeshFileCheck run() {
@@ -92,9 +78,9 @@ class MeshFileChecker {
     return -1;
   }
   // The run of faces_ with this key: the tets that have the face.
-  std::span<const TetFace> tets_with(const Face& sorted_key) const {
-    const auto [first, last] = std::equal_range(faces_.begin(), faces_.end(), TetFace{sorted_key, 0, 0},
-                                                [](const TetFace& a, const TetFace& b) { return a.key < b.key; });
+  std::span<const FaceRecord> tets_with(const Face& sorted_key) const {
+    const auto [first, last] = std::equal_range(faces_.begin(), faces_.end(), FaceRecord{sorted_key, 0, 0},
+                                                [](const FaceRecord& a, const FaceRecord& b) { return a.key < b.key; });
     return {first, last};
   }
   template <class Visit>  // visit(tets sharing one face)
@@ -102,7 +88,7 @@ class MeshFileChecker {
     for (std::size_t i = 0; i < faces_.size();) {
       std::size_t j = i + 1;
       while (j < faces_.size() && faces_[j].key == faces_[i].key) ++j;
-      visit(std::span<const TetFace>(faces_.data() + i, j - i));
+      visit(std::span<const FaceRecord>(faces_.data() + i, j - i));
       i = j;
     }
   }
@@ -110,7 +96,7 @@ class MeshFileChecker {
   CheckResult conformity() const {
     CheckResult check = named("conformity");
     std::int64_t interior = 0, boundary = 0;
-    for_each_face([&](std::span<const TetFace> sharing) {
+    for_each_face([&](std::span<const FaceRecord> sharing) {
       const Face& key = sharing[0].key;
       if (sharing.size() > 2) {
         problem(check, face_name(key), " is shared by ", sharing.size(), " tets (", tet_name(sharing[0].tet), ", ",
@@ -118,7 +104,7 @@ class MeshFileChecker {
       } else if (sharing.size() == 2) {
         ++interior;
         // The opposite vertices of two tets on the two sides of a face are on opposite sides of its plane.
-        auto side = [&](const TetFace& f) {
+        auto side = [&](const FaceRecord& f) {
           const int apex = mesh_.tets[f.tet][f.local_face];
           return signed_volume(point(key[0]), point(key[1]), point(key[2]), point(apex)) > 0.0;
         };
@@ -199,7 +185,7 @@ class MeshFileChecker {
     // The unshared faces of the tets and the box sides' faces are the same set.
     std::ranges::sort(side_faces);
     std::int64_t boundary = 0;
-    for_each_face([&](std::span<const TetFace> sharing) {
+    for_each_face([&](std::span<const FaceRecord> sharing) {
       if (sharing.size() != 1) return;
       ++boundary;
       if (!std::ranges::binary_search(side_faces, sharing[0].key))
@@ -256,7 +242,7 @@ class MeshFileChecker {
   int max_reported_;
   Eigen::Vector3d lo_, hi_;
   double tolerance_ = 0.0;
-  std::vector<TetFace> faces_;  // every local face of every tet, sorted by key
+  std::vector<FaceRecord> faces_ = sorted_face_records(mesh_.tets);  // every local face of every tet, sorted by key
 };
 
 }  // namespace

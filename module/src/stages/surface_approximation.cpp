@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <optional>
 #include <sstream>
@@ -532,46 +533,27 @@ void clear_tag(TetMesh& mesh, FaceTag tag) {
       if (t == tag) t = no_face_tag;
 }
 
-// Sides of S of mesh nodes (SideClassifier::classify), each computed when first needed: refinement
-// creates nodes while healing, and only a few of them are ever asked about.
-class NodeSides {
- public:
-  NodeSides(const TetMesh& mesh, const SideClassifier& sides)
-      : mesh_(mesh), sides_(sides), side_(mesh.points.size(), unknown) {}
+// The side of a node not classified yet.
+constexpr std::int8_t unknown_side = 2;
 
-  // Classifies `nodes` at once, in parallel.
-  void classify(const std::vector<VertexId>& nodes) {
-    const auto count = static_cast<std::int64_t>(nodes.size());
-#pragma omp parallel for schedule(dynamic, 256)
-    for (std::int64_t i = 0; i < count; ++i)
-      side_[nodes[i]] = static_cast<std::int8_t>(sides_.classify(mesh_.points[nodes[i]]));
-  }
-  std::int8_t operator()(VertexId v) {
-    if (static_cast<std::size_t>(v) >= side_.size()) side_.resize(mesh_.points.size(), unknown);
-    if (side_[v] == unknown) side_[v] = static_cast<std::int8_t>(sides_.classify(mesh_.points[v]));
-    return side_[v];
-  }
-
- private:
-  static constexpr std::int8_t unknown = 2;
-  const TetMesh& mesh_;
-  const SideClassifier& sides_;
-  std::vector<std::int8_t> side_;
-};
-
-// Tags the boundary faces of V_M off the box with three nodes on `side`; returns an empty string, or the
-// reason why there are none.
-std::string tag_faces_on_side(TetMesh& mesh, const TetRegion& volumetric, NodeSides& node_side, FaceTag tag,
-                              int side, HealingStats& stats) {
+// Classifies the boundary nodes of V_M into `node_side` (the others are left unknown) and tags the
+// boundary faces off the box with three nodes on `side`; returns an empty string, or the reason why
+// there are none.
+std::string tag_faces_on_side(TetMesh& mesh, const TetRegion& volumetric, const SideClassifier& sides, FaceTag tag,
+                              int side, std::vector<std::int8_t>& node_side, HealingStats& stats) {
   const VolumeBoundary boundary = read_volume_boundary(mesh, volumetric);
   std::vector<VertexId> nodes;
   for (const auto& f : boundary.nodes) nodes.insert(nodes.end(), f.begin(), f.end());
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-  node_side.classify(nodes);
+  node_side.assign(mesh.points.size(), unknown_side);
+  const auto count = static_cast<std::int64_t>(nodes.size());
+#pragma omp parallel for schedule(dynamic, 256)
+  for (std::int64_t i = 0; i < count; ++i)
+    node_side[nodes[i]] = static_cast<std::int8_t>(sides.classify(mesh.points[nodes[i]]));
   for (std::size_t i = 0; i < boundary.faces.size(); ++i) {
     const auto& f = boundary.nodes[i];
-    if (!boundary.on_box[i] && node_side(f[0]) == side && node_side(f[1]) == side && node_side(f[2]) == side) {
+    if (!boundary.on_box[i] && node_side[f[0]] == side && node_side[f[1]] == side && node_side[f[2]] == side) {
       set_face_tag(mesh, boundary.faces[i].tet, boundary.faces[i].local_face, tag);
       ++stats.initial_faces;
     }
@@ -596,8 +578,9 @@ struct ReflexCornerHistory {
 // A node is filled once at most: a fill can make corbels whose removal brings the corner back.
 // Returns the number of faces added.
 std::int64_t fill_reflex_corners(TetMesh& mesh, const TetRegion& volumetric,
-                                 const std::vector<VertexId>& reflex_corners, NodeSides& node_side, FaceTag tag,
-                                 int side, ReflexCornerHistory& history, HealingStats& stats) {
+                                 const std::vector<VertexId>& reflex_corners,
+                                 const std::function<std::int8_t(VertexId)>& side_of, FaceTag tag, int side,
+                                 ReflexCornerHistory& history, HealingStats& stats) {
   if (reflex_corners.empty()) return 0;
   std::int64_t filled_now = 0;
   const VertexTets incidence = vertex_to_tets(mesh);
@@ -607,7 +590,7 @@ std::int64_t fill_reflex_corners(TetMesh& mesh, const TetRegion& volumetric,
     const bool filled_before = std::binary_search(history.filled.begin(), history.filled.end(), node);
     const bool can_fill = !filled_before && !missing.empty() && std::all_of(missing.begin(), missing.end(), [&](const FaceRef& f) {
       const auto nodes_of_face = face_nodes(mesh, f.tet, f.local_face);
-      return std::all_of(nodes_of_face.begin(), nodes_of_face.end(), [&](VertexId v) { return node_side(v) != -side; });
+      return std::all_of(nodes_of_face.begin(), nodes_of_face.end(), [&](VertexId v) { return side_of(v) != -side; });
     });
     if (can_fill) {
       for (const FaceRef& f : missing) set_face_tag(mesh, f.tet, f.local_face, tag);
@@ -655,9 +638,15 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
                       const SurfaceApproximationOptions& options, const std::vector<TetRegion*>& other_regions,
                       HealingStats& stats) {
   clear_tag(mesh, tag);
-  NodeSides node_side(mesh, sides);
-  if (std::string failure = tag_faces_on_side(mesh, volumetric, node_side, tag, side, stats); !failure.empty())
+  std::vector<std::int8_t> node_side;
+  if (std::string failure = tag_faces_on_side(mesh, volumetric, sides, tag, side, node_side, stats); !failure.empty())
     return failure;
+  // Sides of nodes created by refinement are computed when first needed.
+  auto side_of = [&](VertexId v) {
+    if (static_cast<std::size_t>(v) >= node_side.size()) node_side.resize(mesh.points.size(), unknown_side);
+    if (node_side[v] == unknown_side) node_side[v] = static_cast<std::int8_t>(sides.classify(mesh.points[v]));
+    return node_side[v];
+  };
 
   std::vector<TetRegion*> regions = other_regions;
   regions.push_back(&volumetric);
@@ -677,7 +666,7 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
     }
     const std::vector<VertexId> reflex_corners = reflex_rim_corners(mesh, s);
     if (const std::int64_t filled =
-            fill_reflex_corners(mesh, volumetric, reflex_corners, node_side, tag, side, reflex_history, stats);
+            fill_reflex_corners(mesh, volumetric, reflex_corners, side_of, tag, side, reflex_history, stats);
         filled > 0) {
       stats.filled_faces += filled;
       continue;

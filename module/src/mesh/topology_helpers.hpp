@@ -69,7 +69,7 @@ struct TriangleTopology {
 struct TopologyScratch {
   std::vector<std::pair<Edge, std::size_t>> edges;  // (edge, triangle)
   std::vector<std::pair<VertexId, int>> fans;       // (vertex, +1 per triangle, -1 per interior edge)
-  std::vector<Edge> boundary;                       // edges in one triangle
+  std::vector<Edge> boundary;                       // edges in one triangle, sorted
   std::vector<VertexId> vertices;                   // sorted, distinct
   std::vector<std::uint8_t> on_boundary;            // per entry of `vertices`
   UnionFind components{0};

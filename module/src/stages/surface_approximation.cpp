@@ -118,9 +118,7 @@ Interface read_interface(const TetMesh& mesh, const TetRegion& volumetric, FaceT
         for (VertexId v : nodes) s.on_interface[v] = 1;
       }
     }
-  for (int i = 0; i < static_cast<int>(s.nodes.size()); ++i)
-    for (int k = 0; k < 3; ++k) s.edge_faces.push_back({make_edge(s.nodes[i][k], s.nodes[i][(k + 1) % 3]), i});
-  std::sort(s.edge_faces.begin(), s.edge_faces.end());
+  s.edge_faces = detail::edges_with_triangles(s.nodes);
   for (std::size_t i = 0; i < s.edge_faces.size();) {
     std::size_t j = i + 1;
     while (j < s.edge_faces.size() && s.edge_faces[j].first == s.edge_faces[i].first) ++j;
@@ -480,19 +478,11 @@ std::vector<FaceRef> missing_squares_at(const TetMesh& mesh, const TetRegion& vo
 class SideClassifier {
  public:
   SideClassifier(const TriangleSurface& surface, const TriangleBVH& tree) : surface_(surface), tree_(tree) {
-    for (const auto& t : surface.triangles)
-      for (int k = 0; k < 3; ++k) edges_.push_back(make_edge(t[k], t[(k + 1) % 3]));
-    std::sort(edges_.begin(), edges_.end());
+    TopologyScratch scratch;
+    triangle_topology(surface.triangles, scratch);
+    rim_edges_ = std::move(scratch.boundary);
     rim_vertex_.assign(surface.points.size(), 0);
-    for (std::size_t i = 0; i < edges_.size();) {
-      std::size_t j = i + 1;
-      while (j < edges_.size() && edges_[j] == edges_[i]) ++j;
-      if (j - i == 1) {
-        rim_edges_.push_back(edges_[i]);
-        rim_vertex_[edges_[i].first] = rim_vertex_[edges_[i].second] = 1;
-      }
-      i = j;
-    }
+    for (const Edge& e : rim_edges_) rim_vertex_[e.first] = rim_vertex_[e.second] = 1;
   }
 
   int classify(const Eigen::Vector3d& x) const {
@@ -523,7 +513,7 @@ class SideClassifier {
 
   const TriangleSurface& surface_;
   const TriangleBVH& tree_;
-  std::vector<Edge> edges_, rim_edges_;
+  std::vector<Edge> rim_edges_;  // sorted
   std::vector<std::uint8_t> rim_vertex_;
 };
 

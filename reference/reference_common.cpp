@@ -90,28 +90,19 @@ std::vector<TriangleSurface> read_valid_surfaces(const CommonOptions& options, c
 
 MeshSummary summarize_tets(std::size_t tet_count, std::size_t node_count,
                            const std::function<TetPoints(std::size_t)>& points_of_tet) {
-  MeshSummary summary{.tets = tet_count, .nodes = node_count, .min_mean_ratio = 1.0};
-  double squared_deviations = 0.0;  // Welford's running mean and variance
+  QualityAccumulator quality;
+  double max_volume = 0.0;
   for (std::size_t t = 0; t < tet_count; ++t) {
     const TetPoints p = points_of_tet(t);
-    const double volume = signed_volume(p[0], p[1], p[2], p[3]);
-    const bool valid = volume > 0.0 && std::isfinite(volume);
-    // Clamped because rounding may flip the sign of a nearly flat tet's determinant.
-    const double eta = valid ? std::max(0.0, mean_ratio_equilateral(p)) : 0.0;
-    summary.inverted += valid ? 0 : 1;
-    summary.max_volume = std::max(summary.max_volume, valid ? volume : 0.0);
-    summary.min_mean_ratio = std::min(summary.min_mean_ratio, eta);
-    const double delta = eta - summary.mean_mean_ratio;
-    summary.mean_mean_ratio += delta / static_cast<double>(t + 1);
-    squared_deviations += delta * (eta - summary.mean_mean_ratio);
-    if (!valid) continue;
-    for (double angle : dihedral_angles_deg(p)) {
-      summary.min_dihedral_deg = std::min(summary.min_dihedral_deg, angle);
-      summary.max_dihedral_deg = std::max(summary.max_dihedral_deg, angle);
-    }
+    quality.add(p);
+    if (const double volume = signed_volume(p[0], p[1], p[2], p[3]); std::isfinite(volume))
+      max_volume = std::max(max_volume, volume);
   }
-  if (tet_count > 0) summary.std_mean_ratio = std::sqrt(squared_deviations / static_cast<double>(tet_count));
-  return summary;
+  const QualitySummary summary = quality.summary();
+  return {.tets = tet_count, .nodes = node_count, .inverted = static_cast<std::size_t>(summary.inverted),
+          .min_mean_ratio = summary.equilateral.min, .mean_mean_ratio = summary.equilateral.mean,
+          .std_mean_ratio = summary.equilateral.std, .min_dihedral_deg = summary.min_dihedral_deg,
+          .max_dihedral_deg = summary.max_dihedral_deg, .max_volume = max_volume};
 }
 
 std::string describe(const MeshSummary& summary) {

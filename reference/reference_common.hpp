@@ -78,8 +78,8 @@ struct MeshSummary {
   double max_volume = 0.0;                                   // the largest tet's volume
 };
 
-// Quality of tets 0 .. tet_count - 1, tet t having the corners points_of_tet(t) in the file's order.
-// meccano::summarize_quality itself takes a meccano TetMesh, which another mesher's output is not.
+// Quality of tets 0 .. tet_count - 1, tet t having the corners points_of_tet(t) in the file's order,
+// added to one meccano::QualityAccumulator in tet order (points_of_tet need not be thread-safe).
 MeshSummary summarize_tets(std::size_t tet_count, std::size_t node_count,
                            const std::function<TetPoints(std::size_t)>& points_of_tet);
 

@@ -23,12 +23,6 @@ CheckResult named(std::string name) {
   return check;
 }
 
-struct TetFace {
-  Face key;  // sorted
-  int tet;
-  int local_face;
-};
-
 class MeshFileChecker {
  public:
   MeshFileChecker(const MshMesh& mesh, int max_reported) : mesh_(mesh), max_reported_(max_reported) {
@@ -38,14 +32,6 @@ class MeshFileChecker {
       hi_ = hi_.cwiseMax(p);
     }
     tolerance_ = 1e-9 * (hi_ - lo_).maxCoeff();
-    for (int t = 0; t < static_cast<int>(mesh.tets.size()); ++t)
-      for (int f = 0; f < 4; ++f) {
-        Face key;
-        for (int k = 0; k < 3; ++k) key[k] = mesh.tets[t][face_vertices[f][k]];
-        std::sort(key.begin(), key.end());
-        faces_.push_back({key, t, f});
-      }
-    std::sort(faces_.begin(), faces_.end(), [](const TetFace& a, const TetFace& b) { return a.key < b.key; });
   }
 
   MeshFileCheck run() {
@@ -92,9 +78,9 @@ class MeshFileChecker {
     return -1;
   }
   // The run of faces_ with this key: the tets that have the face.
-  std::span<const TetFace> tets_with(const Face& sorted_key) const {
-    const auto [first, last] = std::equal_range(faces_.begin(), faces_.end(), TetFace{sorted_key, 0, 0},
-                                                [](const TetFace& a, const TetFace& b) { return a.key < b.key; });
+  std::span<const FaceRecord> tets_with(const Face& sorted_key) const {
+    const auto [first, last] = std::equal_range(faces_.begin(), faces_.end(), FaceRecord{sorted_key, 0, 0},
+                                                [](const FaceRecord& a, const FaceRecord& b) { return a.key < b.key; });
     return {first, last};
   }
   template <class Visit>  // visit(tets sharing one face)
@@ -102,7 +88,7 @@ class MeshFileChecker {
     for (std::size_t i = 0; i < faces_.size();) {
       std::size_t j = i + 1;
       while (j < faces_.size() && faces_[j].key == faces_[i].key) ++j;
-      visit(std::span<const TetFace>(faces_.data() + i, j - i));
+      visit(std::span<const FaceRecord>(faces_.data() + i, j - i));
       i = j;
     }
   }
@@ -110,7 +96,7 @@ class MeshFileChecker {
   CheckResult conformity() const {
     CheckResult check = named("conformity");
     std::int64_t interior = 0, boundary = 0;
-    for_each_face([&](std::span<const TetFace> sharing) {
+    for_each_face([&](std::span<const FaceRecord> sharing) {
       const Face& key = sharing[0].key;
       if (sharing.size() > 2) {
         problem(check, face_name(key), " is shared by ", sharing.size(), " tets (", tet_name(sharing[0].tet), ", ",
@@ -118,7 +104,7 @@ class MeshFileChecker {
       } else if (sharing.size() == 2) {
         ++interior;
         // The opposite vertices of two tets on the two sides of a face are on opposite sides of its plane.
-        auto side = [&](const TetFace& f) {
+        auto side = [&](const FaceRecord& f) {
           const int apex = mesh_.tets[f.tet][f.local_face];
           return signed_volume(point(key[0]), point(key[1]), point(key[2]), point(apex)) > 0.0;
         };
@@ -199,7 +185,7 @@ class MeshFileChecker {
     // The unshared faces of the tets and the box sides' faces are the same set.
     std::ranges::sort(side_faces);
     std::int64_t boundary = 0;
-    for_each_face([&](std::span<const TetFace> sharing) {
+    for_each_face([&](std::span<const FaceRecord> sharing) {
       if (sharing.size() != 1) return;
       ++boundary;
       if (!std::ranges::binary_search(side_faces, sharing[0].key))
@@ -227,48 +213,27 @@ class MeshFileChecker {
     detail::TopologyScratch scratch;
     std::vector<VertexId> vertices;
     const detail::TriangleTopology topology = detail::triangle_topology(triangles, scratch, &vertices);
-    // An edge of a consistently oriented surface is run once in each direction; the boundary edges (in
-    // one triangle) form the boundary loops.
+    // An edge of a consistently oriented surface is run once in each direction.
     std::vector<std::pair<VertexId, VertexId>> directed;
-    std::vector<detail::Edge> undirected;
     for (const auto& t : triangles)
-      for (int k = 0; k < 3; ++k) {
-        directed.push_back({t[k], t[(k + 1) % 3]});
-        undirected.push_back(detail::make_edge(t[k], t[(k + 1) % 3]));
-      }
+      for (int k = 0; k < 3; ++k) directed.push_back({t[k], t[(k + 1) % 3]});
     std::ranges::sort(directed);
-    std::ranges::sort(undirected);
     std::int64_t flipped = 0;
     for (std::size_t i = 1; i < directed.size(); ++i) flipped += directed[i] == directed[i - 1];
-    detail::UnionFind loops(vertices.size());
-    std::vector<char> on_boundary(vertices.size(), 0);
-    auto index = [&](VertexId v) { return static_cast<std::size_t>(std::ranges::lower_bound(vertices, v) - vertices.begin()); };
-    for (std::size_t i = 0; i < undirected.size();) {
-      std::size_t j = i + 1;
-      while (j < undirected.size() && undirected[j] == undirected[i]) ++j;
-      if (j - i == 1) {
-        const auto [a, b] = undirected[i];
-        loops.join(index(a), index(b));
-        on_boundary[index(a)] = on_boundary[index(b)] = 1;
-      }
-      i = j;
-    }
-    std::int64_t boundary_loops = 0;
-    for (std::size_t v = 0; v < vertices.size(); ++v) boundary_loops += on_boundary[v] && loops.find(v) == v;
 
     if (triangles.empty()) problem(check, "the group has no triangles");
     if (topology.components > 1) problem(check, topology.components, " connected components (a disk has one)");
     if (topology.overloaded_edges > 0) problem(check, topology.overloaded_edges, " edges in more than two triangles");
     if (topology.pinched_vertices > 0) problem(check, topology.pinched_vertices, " pinched vertices");
     if (topology.euler() != 1) problem(check, "Euler characteristic ", topology.euler(), " (a disk has 1)");
-    if (boundary_loops != 1) problem(check, boundary_loops, " boundary loops (a disk has one)");
+    if (topology.boundary_loops != 1) problem(check, topology.boundary_loops, " boundary loops (a disk has one)");
     if (flipped > 0) problem(check, flipped, " edges run twice in the same direction (inconsistent orientation)");
     // Not a defect of the mesh, but a fault solver that splits the interface's nodes needs a node off the
     // interface in every tet: counted, not failed (a coarse mesh that keeps the surface may have some).
     const auto on_interface = [&](int node) { return std::ranges::binary_search(vertices, node); };
     const auto lying_on = std::ranges::count_if(mesh_.tets, [&](const std::array<int, 4>& tet) { return std::ranges::all_of(tet, on_interface); });
     check.summary = std::to_string(triangles.size()) + " triangles, Euler characteristic " +
-                    std::to_string(topology.euler()) + ", " + std::to_string(boundary_loops) + " boundary loop(s)";
+                    std::to_string(topology.euler()) + ", " + std::to_string(topology.boundary_loops) + " boundary loop(s)";
     if (lying_on > 0) check.summary += ", " + std::to_string(lying_on) + " tets with all four nodes on it";
     return check;
   }
@@ -277,7 +242,7 @@ class MeshFileChecker {
   int max_reported_;
   Eigen::Vector3d lo_, hi_;
   double tolerance_ = 0.0;
-  std::vector<TetFace> faces_;  // every local face of every tet, sorted by key
+  std::vector<FaceRecord> faces_ = sorted_face_records(mesh_.tets);  // every local face of every tet, sorted by key
 };
 
 }  // namespace

@@ -39,38 +39,15 @@ double area_of(const TriangleSurface& surface) {
 
 void measure_quality(const MshMesh& mesh, MeshMeasure& measure) {
   const auto tets = static_cast<std::int64_t>(mesh.tets.size());
-  std::vector<double> eta(mesh.tets.size());
-  std::int64_t inverted = 0;
-  double min_dihedral = 180.0, max_dihedral = 0.0;
-#pragma omp parallel for reduction(+ : inverted) reduction(min : min_dihedral) reduction(max : max_dihedral)
-  for (std::int64_t t = 0; t < tets; ++t) {
+  const QualitySummary summary = summarize_tet_quality(tets, [&](std::int64_t t, QualityAccumulator& quality) {
     const auto& v = mesh.tets[t];
-    const TetPoints p{mesh.points[v[0]], mesh.points[v[1]], mesh.points[v[2]], mesh.points[v[3]]};
-    const double volume = signed_volume(p[0], p[1], p[2], p[3]);
-    if (!(volume > 0.0 && std::isfinite(volume))) {
-      ++inverted;
-      eta[t] = 0.0;
-      continue;
-    }
-    eta[t] = mean_ratio_equilateral(p);  // positive: its sign is that of the same signed_volume
-    for (const double angle : dihedral_angles_deg(p)) {
-      min_dihedral = std::min(min_dihedral, angle);
-      max_dihedral = std::max(max_dihedral, angle);
-    }
-  }
-  measure.inverted = inverted;
-  const bool any_valid = inverted < tets;
-  measure.min_dihedral_deg = any_valid ? min_dihedral : 0.0;
-  measure.max_dihedral_deg = any_valid ? max_dihedral : 180.0;
-  if (eta.empty()) return;
-  const double mean = mean_of(eta);
-  long double squared_deviations = 0;
-  for (const double q : eta) {
-    squared_deviations += (q - mean) * (q - mean);
-    for (std::size_t k = 0; k < low_quality_thresholds.size(); ++k) measure.below[k] += q < low_quality_thresholds[k];
-  }
-  measure.equilateral = {*std::ranges::min_element(eta), mean,
-                         static_cast<double>(std::sqrt(squared_deviations / static_cast<long double>(eta.size())))};
+    quality.add({mesh.points[v[0]], mesh.points[v[1]], mesh.points[v[2]], mesh.points[v[3]]});
+  });
+  measure.inverted = summary.inverted;
+  measure.equilateral = summary.equilateral;
+  measure.below = summary.equilateral_below;
+  measure.min_dihedral_deg = summary.min_dihedral_deg;
+  measure.max_dihedral_deg = summary.max_dihedral_deg;
 }
 
 // The group's triangles as a surface of their own, its nodes renumbered, the file's vertex order kept.

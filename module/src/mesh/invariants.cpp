@@ -92,7 +92,7 @@ class Checker {
   }
 
   void check_faces() {
-    const auto faces = sorted_face_records(mesh_);
+    const auto faces = sorted_face_records(mesh_.tets);
     std::array<int128, 6> side_area{};
     for (std::size_t i = 0; i < faces.size();) {
       std::size_t j = i + 1;

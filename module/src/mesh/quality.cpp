@@ -47,86 +47,6 @@ std::array<double, 6> dihedral_cosines(const TetPoints& p) {
 
 double degrees_from_cosine(double cosine) { return std::acos(cosine) * 180.0 / std::numbers::pi; }
 
-// Count, mean, sum of squared deviations and minimum, updated by Welford's rule and merged by Chan et
-// al.'s: the spread of values that are all nearly 1 survives, unlike with a sum of squares.
-struct Moments {
-  std::int64_t count = 0;
-  double mean = 0, squared_deviations = 0, min = std::numeric_limits<double>::infinity();
-
-  void merge(const Moments& other) {
-    if (other.count == 0) return;
-    if (count == 0) {
-      *this = other;
-      return;
-    }
-    const auto total = static_cast<double>(count + other.count);
-    const double delta = other.mean - mean;
-    mean += delta * static_cast<double>(other.count) / total;
-    squared_deviations += other.squared_deviations +
-                          delta * delta * static_cast<double>(count) * static_cast<double>(other.count) / total;
-    min = std::min(min, other.min);
-    count += other.count;
-  }
-  void add(double q) {
-    ++count;
-    const double delta = q - mean;
-    mean += delta / static_cast<double>(count);
-    squared_deviations += delta * (q - mean);
-    min = std::min(min, q);
-  }
-  QualityStatistics statistics() const {
-    if (count == 0) return {};
-    return {min, mean, std::sqrt(squared_deviations / static_cast<double>(count))};
-  }
-};
-
-struct QualityAccumulator {
-  Moments meccano, equilateral;
-  std::int64_t inverted = 0;
-  double largest_cosine = -1.0, smallest_cosine = 1.0;  // over the dihedral angles of valid tets
-  std::vector<std::int64_t> meccano_bins, equilateral_bins;
-
-  explicit QualityAccumulator(int bins) : meccano_bins(bins, 0), equilateral_bins(bins, 0) {}
-
-  void add_tet(const TetMesh& mesh, TetId t) {
-    const TetPoints p = oriented_points(mesh, t);
-    const double volume = signed_volume(p[0], p[1], p[2], p[3]);
-    if (!(volume > 0.0 && std::isfinite(volume))) {
-      ++inverted;
-      add_quality(0.0, 0.0);
-      return;
-    }
-    // Clamped because rounding may flip the sign of a nearly flat tet's determinant.
-    add_quality(std::max(0.0, mean_ratio_meccano(mesh, t)),
-                std::max(0.0, mean_ratio_equilateral(p)));
-    for (double cosine : dihedral_cosines(p)) {
-      largest_cosine = std::max(largest_cosine, cosine);
-      smallest_cosine = std::min(smallest_cosine, cosine);
-    }
-  }
-  void add_quality(double q_meccano, double q_equilateral) {
-    meccano.add(q_meccano);
-    equilateral.add(q_equilateral);
-    ++meccano_bins[bin_of(q_meccano)];
-    ++equilateral_bins[bin_of(q_equilateral)];
-  }
-  std::size_t bin_of(double q) const {
-    const auto bins = static_cast<int>(meccano_bins.size());
-    return static_cast<std::size_t>(std::min(static_cast<int>(q * bins), bins - 1));
-  }
-  void merge(const QualityAccumulator& other) {
-    meccano.merge(other.meccano);
-    equilateral.merge(other.equilateral);
-    inverted += other.inverted;
-    largest_cosine = std::max(largest_cosine, other.largest_cosine);
-    smallest_cosine = std::min(smallest_cosine, other.smallest_cosine);
-    for (std::size_t b = 0; b < meccano_bins.size(); ++b) {
-      meccano_bins[b] += other.meccano_bins[b];
-      equilateral_bins[b] += other.equilateral_bins[b];
-    }
-  }
-};
-
 }  // namespace
 
 double signed_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
@@ -198,36 +118,122 @@ double mean_ratio_meccano(const TetMesh& mesh, TetId t) {
   return mesh.bisectable(t) ? mean_ratio_relative(p, oriented_computational_points(mesh, t)) : mean_ratio_equilateral(p);
 }
 
-QualitySummary summarize_quality(const TetMesh& mesh, int histogram_bins) {
+void QualityAccumulator::Moments::merge(const Moments& other) {
+  if (other.count == 0) return;
+  if (count == 0) {
+    *this = other;
+    return;
+  }
+  const auto total = static_cast<double>(count + other.count);
+  const double delta = other.mean - mean;
+  mean += delta * static_cast<double>(other.count) / total;
+  squared_deviations += other.squared_deviations +
+                        delta * delta * static_cast<double>(count) * static_cast<double>(other.count) / total;
+  min = std::min(min, other.min);
+  count += other.count;
+}
+
+QualityAccumulator::QualityAccumulator(int histogram_bins) {
   if (histogram_bins < 1)
     throw std::invalid_argument("summarize_quality: " + std::to_string(histogram_bins) + " histogram bins");
+  meccano_bins_.assign(static_cast<std::size_t>(histogram_bins), 0);
+  equilateral_bins_.assign(static_cast<std::size_t>(histogram_bins), 0);
+}
+
+void QualityAccumulator::add(const TetPoints& p, const TetPoints* computational) {
+  const double volume = signed_volume(p[0], p[1], p[2], p[3]);
+  if (!(volume > 0.0 && std::isfinite(volume))) {
+    ++inverted_;
+    add_quality(0.0, 0.0);
+    return;
+  }
+  // Clamped because rounding may flip the sign of a nearly flat tet's determinant.
+  const double q_equilateral = std::max(0.0, mean_ratio_equilateral(p));
+  add_quality(computational ? std::max(0.0, mean_ratio_relative(p, *computational)) : q_equilateral, q_equilateral);
+  for (double cosine : dihedral_cosines(p)) {
+    largest_cosine_ = std::max(largest_cosine_, cosine);
+    smallest_cosine_ = std::min(smallest_cosine_, cosine);
+  }
+}
+
+void QualityAccumulator::add_quality(double q_meccano, double q_equilateral) {
+  const auto bins = static_cast<int>(meccano_bins_.size());
+  const auto bin_of = [&](double q) {
+    return static_cast<std::size_t>(std::min(static_cast<int>(q * bins), bins - 1));
+  };
+  meccano_.add(q_meccano);
+  equilateral_.add(q_equilateral);
+  ++meccano_bins_[bin_of(q_meccano)];
+  ++equilateral_bins_[bin_of(q_equilateral)];
+  for (std::size_t k = 0; k < low_quality_thresholds.size(); ++k)
+    equilateral_below_[k] += q_equilateral < low_quality_thresholds[k];
+}
+
+void QualityAccumulator::merge(const QualityAccumulator& other) {
+  meccano_.merge(other.meccano_);
+  equilateral_.merge(other.equilateral_);
+  inverted_ += other.inverted_;
+  for (std::size_t k = 0; k < equilateral_below_.size(); ++k) equilateral_below_[k] += other.equilateral_below_[k];
+  largest_cosine_ = std::max(largest_cosine_, other.largest_cosine_);
+  smallest_cosine_ = std::min(smallest_cosine_, other.smallest_cosine_);
+  for (std::size_t b = 0; b < meccano_bins_.size(); ++b) {
+    meccano_bins_[b] += other.meccano_bins_[b];
+    equilateral_bins_[b] += other.equilateral_bins_[b];
+  }
+}
+
+QualitySummary QualityAccumulator::summary() const {
+  QualitySummary summary;
+  summary.tets = meccano_.count;
+  summary.inverted = inverted_;
+  const auto statistics = [](const Moments& m) {
+    if (m.count == 0) return QualityStatistics{};
+    return QualityStatistics{m.min, m.mean, std::sqrt(m.squared_deviations / static_cast<double>(m.count))};
+  };
+  summary.meccano = statistics(meccano_);
+  summary.equilateral = statistics(equilateral_);
+  summary.equilateral_below = equilateral_below_;
+  const bool any_valid = summary.inverted < summary.tets;
+  summary.min_dihedral_deg = any_valid ? degrees_from_cosine(largest_cosine_) : 0.0;
+  summary.max_dihedral_deg = any_valid ? degrees_from_cosine(smallest_cosine_) : 180.0;
+  summary.meccano_histogram.counts = meccano_bins_;
+  summary.equilateral_histogram.counts = equilateral_bins_;
+  return summary;
+}
+
+QualitySummary summarize_tet_quality(std::int64_t tet_count,
+                                     const std::function<void(std::int64_t, QualityAccumulator&)>& add_tet,
+                                     int histogram_bins) {
   // Fixed chunks, each summed alone and merged in chunk order: the rounding, hence the result, does not
   // depend on the number of threads or on which thread took which chunk.
   constexpr std::int64_t chunk_tets = 4096;
-  const std::int64_t tets = mesh.num_tets();
-  const std::int64_t chunks = (tets + chunk_tets - 1) / chunk_tets;
+  const std::int64_t chunks = (tet_count + chunk_tets - 1) / chunk_tets;
   std::vector<QualityAccumulator> partial(static_cast<std::size_t>(chunks), QualityAccumulator(histogram_bins));
 #pragma omp parallel for schedule(dynamic)
   for (std::int64_t c = 0; c < chunks; ++c) {
     QualityAccumulator chunk(histogram_bins);  // local: threads do not share cache lines while summing
-    const std::int64_t end = std::min(tets, (c + 1) * chunk_tets);
-    for (std::int64_t t = c * chunk_tets; t < end; ++t) chunk.add_tet(mesh, static_cast<TetId>(t));
+    const std::int64_t end = std::min(tet_count, (c + 1) * chunk_tets);
+    for (std::int64_t t = c * chunk_tets; t < end; ++t) add_tet(t, chunk);
     partial[static_cast<std::size_t>(c)] = std::move(chunk);
   }
   QualityAccumulator total(histogram_bins);
   for (const auto& chunk : partial) total.merge(chunk);
+  return total.summary();
+}
 
-  QualitySummary summary;
-  summary.tets = tets;
-  summary.inverted = total.inverted;
-  summary.meccano = total.meccano.statistics();
-  summary.equilateral = total.equilateral.statistics();
-  const bool any_valid = summary.inverted < summary.tets;
-  summary.min_dihedral_deg = any_valid ? degrees_from_cosine(total.largest_cosine) : 0.0;
-  summary.max_dihedral_deg = any_valid ? degrees_from_cosine(total.smallest_cosine) : 180.0;
-  summary.meccano_histogram.counts = std::move(total.meccano_bins);
-  summary.equilateral_histogram.counts = std::move(total.equilateral_bins);
-  return summary;
+QualitySummary summarize_quality(const TetMesh& mesh, int histogram_bins) {
+  return summarize_tet_quality(
+      mesh.num_tets(),
+      [&](std::int64_t t, QualityAccumulator& quality) {
+        const auto tet = static_cast<TetId>(t);
+        if (mesh.bisectable(tet)) {
+          const TetPoints computational = oriented_computational_points(mesh, tet);
+          quality.add(oriented_points(mesh, tet), &computational);
+        } else {
+          quality.add(oriented_points(mesh, tet));
+        }
+      },
+      histogram_bins);
 }
 
 }  // namespace meccano

@@ -151,13 +151,13 @@ int grid_orientation(const TetMesh& mesh, TetId t) {
   return (det > 0) - (det < 0);
 }
 
-std::vector<FaceRecord> sorted_face_records(const TetMesh& mesh) {
+std::vector<FaceRecord> sorted_face_records(std::span<const std::array<VertexId, 4>> tets) {
   std::vector<FaceRecord> faces;
-  faces.reserve(4 * mesh.tets.size());
-  for (TetId t = 0; t < mesh.num_tets(); ++t)
+  faces.reserve(4 * tets.size());
+  for (TetId t = 0; t < static_cast<TetId>(tets.size()); ++t)
     for (int f = 0; f < 4; ++f) {
       std::array<VertexId, 3> key{};
-      for (int k = 0; k < 3; ++k) key[k] = mesh.tets[t][face_vertices[f][k]];
+      for (int k = 0; k < 3; ++k) key[k] = tets[t][face_vertices[f][k]];
       std::sort(key.begin(), key.end());
       faces.push_back({key, t, f});
     }
@@ -167,7 +167,7 @@ std::vector<FaceRecord> sorted_face_records(const TetMesh& mesh) {
 
 void build_neighbours(TetMesh& mesh) {
   mesh.neighbours.assign(mesh.tets.size(), {no_tet, no_tet, no_tet, no_tet});
-  const auto faces = sorted_face_records(mesh);
+  const auto faces = sorted_face_records(mesh.tets);
   for (std::size_t i = 0; i < faces.size();) {
     std::size_t j = i + 1;
     while (j < faces.size() && faces[j].key == faces[i].key) ++j;

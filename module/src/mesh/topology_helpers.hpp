@@ -1,6 +1,6 @@
 // Small helpers shared by the stages that reason about the topology of regions and surfaces of the
 // mesh and of S (stages/volumetric_approximation.cpp, stages/surface_approximation.cpp, surface/creases.cpp, stages/pipeline.cpp,
-// surface/validation.cpp).
+// surface/validation.cpp, stages/parameterization.cpp, inspect/mesh_file_check.cpp).
 // Internal: not installed.
 #pragma once
 
@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <numeric>
 #include <span>
 #include <utility>
@@ -51,13 +52,16 @@ class UnionFind {
   std::vector<std::size_t> parent_;
 };
 
-// Counts that decide what a set of triangles is topologically (a disk, a sphere, something else).
+// Counts that decide what a set of triangles is topologically (a disk, a sphere, something else). It is
+// a disk when it is one component, no edge is overloaded, no vertex pinched, the boundary is one loop
+// and the Euler characteristic is 1; each caller reports the counts that fail in its own words.
 struct TriangleTopology {
   std::int64_t vertices = 0, edges = 0, faces = 0;
   std::int64_t boundary_edges = 0;    // in one triangle
   std::int64_t overloaded_edges = 0;  // in more than two
   std::int64_t pinched_vertices = 0;  // whose triangles form more than one open fan
   int components = 0;                 // joined across shared edges
+  int boundary_loops = 0;             // components of the boundary edges
   std::int64_t euler() const { return vertices - edges + faces; }
 };
 
@@ -65,7 +69,11 @@ struct TriangleTopology {
 struct TopologyScratch {
   std::vector<std::pair<Edge, std::size_t>> edges;  // (edge, triangle)
   std::vector<std::pair<VertexId, int>> fans;       // (vertex, +1 per triangle, -1 per interior edge)
+  std::vector<Edge> boundary;                       // edges in one triangle, sorted
+  std::vector<VertexId> vertices;                   // sorted, distinct
+  std::vector<std::uint8_t> on_boundary;            // per entry of `vertices`
   UnionFind components{0};
+  UnionFind loops{0};
 };
 
 // A vertex with d triangles and i interior edges (in exactly two triangles) has d - i open fans when
@@ -79,6 +87,7 @@ inline TriangleTopology triangle_topology(std::span<const std::array<VertexId, 3
   auto& fans = scratch.fans;
   edges.clear();
   fans.clear();
+  scratch.boundary.clear();
   for (std::size_t i = 0; i < triangles.size(); ++i)
     for (int k = 0; k < 3; ++k) {
       edges.push_back({make_edge(triangles[i][k], triangles[i][(k + 1) % 3]), i});
@@ -90,7 +99,7 @@ inline TriangleTopology triangle_topology(std::span<const std::array<VertexId, 3
     std::size_t j = i + 1;
     while (j < edges.size() && edges[j].first == edges[i].first) ++j;
     ++t.edges;
-    t.boundary_edges += j - i == 1;
+    if (j - i == 1) scratch.boundary.push_back(edges[i].first);
     t.overloaded_edges += j - i > 2;
     if (j - i == 2) {
       fans.push_back({edges[i].first.first, -1});
@@ -100,17 +109,31 @@ inline TriangleTopology triangle_topology(std::span<const std::array<VertexId, 3
     i = j;
   }
   t.components = scratch.components.components();
+  t.boundary_edges = static_cast<std::int64_t>(scratch.boundary.size());
   std::sort(fans.begin(), fans.end());
-  if (vertices) vertices->clear();
+  auto& distinct = scratch.vertices;
+  distinct.clear();
   for (std::size_t i = 0; i < fans.size();) {
     std::size_t j = i;
     int open = 0;
     while (j < fans.size() && fans[j].first == fans[i].first) open += fans[j++].second;
     ++t.vertices;
     t.pinched_vertices += open > 1;
-    if (vertices) vertices->push_back(fans[i].first);
+    distinct.push_back(fans[i].first);
     i = j;
   }
+  auto index = [&](VertexId v) {
+    return static_cast<std::size_t>(std::lower_bound(distinct.begin(), distinct.end(), v) - distinct.begin());
+  };
+  scratch.loops.reset(distinct.size());
+  scratch.on_boundary.assign(distinct.size(), 0);
+  for (const Edge& e : scratch.boundary) {
+    scratch.loops.join(index(e.first), index(e.second));
+    scratch.on_boundary[index(e.first)] = scratch.on_boundary[index(e.second)] = 1;
+  }
+  for (std::size_t v = 0; v < distinct.size(); ++v)
+    t.boundary_loops += scratch.on_boundary[v] && scratch.loops.find(v) == v;
+  if (vertices) *vertices = distinct;
   return t;
 }
 

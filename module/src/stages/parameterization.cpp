@@ -3,6 +3,8 @@
 #include <meccano/error.hpp>
 #include <meccano/geometry/geometry.hpp>
 
+#include "mesh/topology_helpers.hpp"
+
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -134,8 +136,8 @@ Connectivity connect(DiskView disk) {
                        " has " + std::to_string(c.rim.size()) + " of the " + std::to_string(rim_edges) +
                        " rim edges");
   // A disk has Euler characteristic 1; one rim loop with a handle or a closed component does not.
-  const long long edges = (3LL * triangle_count + rim_edges) / 2;
-  const long long euler = n - edges + triangle_count;
+  detail::TopologyScratch scratch;
+  const std::int64_t euler = detail::triangle_topology(disk.triangles, scratch).euler();
   if (euler != 1)
     throw MeshingError("parameterization: not a disk: Euler characteristic " + std::to_string(euler) +
                        " (a handle, or more than one component)");
@@ -501,14 +503,12 @@ std::array<int, 4> matching_corners(DiskView disk, const std::array<Vector3d, 4>
   return to_view_ids(c, loop, repair_corners(c, loop, p));
 }
 
-SquareParameterization parameterize_to_square(DiskView disk, const std::array<int, 4>& corners,
-                                              FloaterWeights weights) {
-  const Connectivity c = connect(disk);
-  require_four_rim_vertices(c);
-  const std::vector<Vector3d> x = compact_points(c, disk);
-  const int n = static_cast<int>(c.rim.size());
+namespace {
 
-  // Direction of the walk from corner 0 that meets corners 1, 2, 3 in this order.
+// The direction (+1 or -1) of the rim walk from corner 0 that meets corners 1, 2, 3 (view vertices) in
+// this order.
+int walk_direction(const Connectivity& c, const std::array<int, 4>& corners) {
+  const int n = static_cast<int>(c.rim.size());
   std::array<int, 4> at{};
   for (int k = 0; k < 4; ++k) {
     const int v = corners[k] >= 0 && corners[k] < static_cast<int>(c.local.size()) ? c.local[corners[k]] : -1;
@@ -521,15 +521,14 @@ SquareParameterization parameterize_to_square(DiskView disk, const std::array<in
     const auto offset = [&](int k) { return ((at[k] - at[0]) * direction % n + n) % n; };
     return 0 < offset(1) && offset(1) < offset(2) && offset(2) < offset(3);
   };
-  const int direction = follows(+1) ? +1 : follows(-1) ? -1 : 0;
-  if (direction == 0)
-    throw std::invalid_argument("parameterize_to_square: the corners are not distinct rim vertices in cyclic order");
-  const Loop loop = make_loop(c, x, at[0], direction);
-  std::array<int, 4> p{};
-  for (int k = 0; k < 4; ++k) p[k] = loop.position[c.local[corners[k]]];
+  if (follows(+1)) return +1;
+  if (follows(-1)) return -1;
+  throw std::invalid_argument("parameterize_to_square: the corners are not distinct rim vertices in cyclic order");
+}
 
-  // Tutte/Floater: one-to-one unless an interior edge has both ends on one side. Name a triangle with all
-  // three vertices on that side when there is one (the common case: an ear whose apex is not a corner).
+// Tutte/Floater: one-to-one unless an interior edge has both ends on one side. Name a triangle with all
+// three vertices on that side when there is one (the common case: an ear whose apex is not a corner).
+void require_no_fold(const Connectivity& c, const Loop& loop, const std::array<int, 4>& p) {
   const Sides sides(loop, p);
   std::string fold;
   for (const Chord& chord : rim_chords(c)) {
@@ -548,9 +547,12 @@ SquareParameterization parameterize_to_square(DiskView disk, const std::array<in
              " joins two vertices of " + side_names[flat->side] + " of the square: the map would fold there";
   }
   if (!fold.empty()) throw MeshingError(fold);
+}
 
-  // Rim: chord-length spacing along each side; corner + t * (side direction) keeps the constant
-  // coordinate exactly 0 or 1.
+// Rim: chord-length spacing along each side; corner + t * (side direction) keeps the constant
+// coordinate exactly 0 or 1. Interior vertices are left NaN.
+std::vector<Vector2d> rim_on_square(const Connectivity& c, const Loop& loop, const std::array<int, 4>& p) {
+  const int n = loop.size();
   std::vector<Vector2d> uv(c.global.size(), Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
   for (int k = 0; k < 4; ++k) {
     const int end = k == 3 ? n : p[k + 1];
@@ -562,8 +564,12 @@ SquareParameterization parameterize_to_square(DiskView disk, const std::array<in
       uv[loop.vertices[i]] = square_corners[k] + t * (square_corners[(k + 1) % 4] - square_corners[k]);
     }
   }
+  return uv;
+}
 
-  // Interior: (I - Λ) u = Λ_rim u_rim, one LU factorisation for both coordinates.
+// Interior: (I - Λ) u = Λ_rim u_rim, one LU factorisation for both coordinates.
+void solve_interior(const Connectivity& c, const std::vector<Vector3d>& x, FloaterWeights weights,
+                    std::vector<Vector2d>& uv) {
   std::vector<int> unknown(c.global.size(), -1);
   std::vector<int> interior;
   for (int v = 0; v < c.vertex_count(); ++v) {
@@ -572,39 +578,40 @@ SquareParameterization parameterize_to_square(DiskView disk, const std::array<in
     interior.push_back(v);
   }
   const int m = static_cast<int>(interior.size());
-  if (m > 0) {
-    std::vector<Weights> rows(m);
+  if (m == 0) return;
+  std::vector<Weights> rows(m);
 #pragma omp parallel for schedule(static) if (m > parallel_threshold)
-    for (int r = 0; r < m; ++r) rows[r] = floater_weights(c, x, interior[r], weights);
-    for (int r = 0; r < m; ++r) {
-      if (rows[r].empty() ||
-          !std::all_of(rows[r].begin(), rows[r].end(), [](const auto& entry) { return entry.second > 0.0; }))
-        throw MeshingError("parameterize_to_square: no valid Floater weights at vertex " + c.name(interior[r]) +
-                           " (degenerate triangles around it)");
-    }
-    std::vector<Eigen::Triplet<double>> entries;
-    Eigen::MatrixX2d rhs = Eigen::MatrixX2d::Zero(m, 2);
-    for (int r = 0; r < m; ++r) {
-      entries.emplace_back(r, r, 1.0);
-      for (const auto& [j, w] : rows[r]) {
-        if (unknown[j] >= 0)
-          entries.emplace_back(r, unknown[j], -w);
-        else
-          rhs.row(r) += w * uv[j].transpose();
-      }
-    }
-    Eigen::SparseMatrix<double> matrix(m, m);
-    matrix.setFromTriplets(entries.begin(), entries.end());
-    Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
-    lu.compute(matrix);
-    if (lu.info() != Eigen::Success)
-      throw MeshingError("parameterize_to_square: sparse LU factorisation failed: " + lu.lastErrorMessage());
-    const Eigen::MatrixX2d solution = lu.solve(rhs);
-    if (lu.info() != Eigen::Success) throw MeshingError("parameterize_to_square: sparse LU solve failed");
-    for (int r = 0; r < m; ++r) uv[interior[r]] = solution.row(r).transpose();
+  for (int r = 0; r < m; ++r) rows[r] = floater_weights(c, x, interior[r], weights);
+  for (int r = 0; r < m; ++r) {
+    if (rows[r].empty() ||
+        !std::all_of(rows[r].begin(), rows[r].end(), [](const auto& entry) { return entry.second > 0.0; }))
+      throw MeshingError("parameterize_to_square: no valid Floater weights at vertex " + c.name(interior[r]) +
+                         " (degenerate triangles around it)");
   }
+  std::vector<Eigen::Triplet<double>> entries;
+  Eigen::MatrixX2d rhs = Eigen::MatrixX2d::Zero(m, 2);
+  for (int r = 0; r < m; ++r) {
+    entries.emplace_back(r, r, 1.0);
+    for (const auto& [j, w] : rows[r]) {
+      if (unknown[j] >= 0)
+        entries.emplace_back(r, unknown[j], -w);
+      else
+        rhs.row(r) += w * uv[j].transpose();
+    }
+  }
+  Eigen::SparseMatrix<double> matrix(m, m);
+  matrix.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
+  lu.compute(matrix);
+  if (lu.info() != Eigen::Success)
+    throw MeshingError("parameterize_to_square: sparse LU factorisation failed: " + lu.lastErrorMessage());
+  const Eigen::MatrixX2d solution = lu.solve(rhs);
+  if (lu.info() != Eigen::Success) throw MeshingError("parameterize_to_square: sparse LU solve failed");
+  for (int r = 0; r < m; ++r) uv[interior[r]] = solution.row(r).transpose();
+}
 
-  // Every parametric triangle must have the sign of the walk; find the first that does not.
+// Every parametric triangle must have the sign of the walk; find the first that does not.
+void require_one_to_one(const Connectivity& c, const std::vector<Vector2d>& uv, int direction) {
   const int triangle_count = static_cast<int>(c.triangles.size());
   int first_bad = triangle_count;
 #pragma omp parallel for reduction(min : first_bad) schedule(static) if (triangle_count > parallel_threshold)
@@ -619,6 +626,23 @@ SquareParameterization parameterize_to_square(DiskView disk, const std::array<in
                        c.name(tri[0]) + ", " + c.name(tri[1]) + ", " + c.name(tri[2]) +
                        ") is flipped or flat: the Floater map is not one-to-one");
   }
+}
+
+}  // namespace
+
+SquareParameterization parameterize_to_square(DiskView disk, const std::array<int, 4>& corners,
+                                              FloaterWeights weights) {
+  const Connectivity c = connect(disk);
+  require_four_rim_vertices(c);
+  const std::vector<Vector3d> x = compact_points(c, disk);
+  const int direction = walk_direction(c, corners);
+  const Loop loop = make_loop(c, x, c.rim_position[c.local[corners[0]]], direction);
+  std::array<int, 4> p{};
+  for (int k = 0; k < 4; ++k) p[k] = loop.position[c.local[corners[k]]];
+  require_no_fold(c, loop, p);
+  std::vector<Vector2d> uv = rim_on_square(c, loop, p);
+  solve_interior(c, x, weights, uv);
+  require_one_to_one(c, uv, direction);
 
   SquareParameterization result;
   result.uv.assign(disk.points.size(), Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <optional>
 #include <sstream>
@@ -117,9 +118,7 @@ Interface read_interface(const TetMesh& mesh, const TetRegion& volumetric, FaceT
         for (VertexId v : nodes) s.on_interface[v] = 1;
       }
     }
-  for (int i = 0; i < static_cast<int>(s.nodes.size()); ++i)
-    for (int k = 0; k < 3; ++k) s.edge_faces.push_back({make_edge(s.nodes[i][k], s.nodes[i][(k + 1) % 3]), i});
-  std::sort(s.edge_faces.begin(), s.edge_faces.end());
+  s.edge_faces = detail::edges_with_triangles(s.nodes);
   for (std::size_t i = 0; i < s.edge_faces.size();) {
     std::size_t j = i + 1;
     while (j < s.edge_faces.size() && s.edge_faces[j].first == s.edge_faces[i].first) ++j;
@@ -426,17 +425,7 @@ void check_disk(const TetMesh& mesh, const Interface& s, SurfaceApproximationChe
   c.non_manifold_edges = topology.overloaded_edges;
   c.pinched_nodes = topology.pinched_vertices;
   c.euler = topology.euler();
-  // Rim loops: components of the rim edges.
-  std::vector<VertexId> rim_nodes;
-  for (const Edge& e : s.rim_edges) rim_nodes.insert(rim_nodes.end(), {e.first, e.second});
-  std::sort(rim_nodes.begin(), rim_nodes.end());
-  rim_nodes.erase(std::unique(rim_nodes.begin(), rim_nodes.end()), rim_nodes.end());
-  UnionFind loops(rim_nodes.size());
-  auto index = [&](VertexId v) {
-    return static_cast<std::size_t>(std::lower_bound(rim_nodes.begin(), rim_nodes.end(), v) - rim_nodes.begin());
-  };
-  for (const Edge& e : s.rim_edges) loops.join(index(e.first), index(e.second));
-  for (std::size_t i = 0; i < rim_nodes.size(); ++i) c.rim_loops += loops.find(i) == i;
+  c.rim_loops = topology.boundary_loops;
   for (const Edge& e : s.rim_edges) c.oblique_rim_edges += !edge_is_axis_parallel(mesh, e.first, e.second);
 }
 
@@ -489,19 +478,11 @@ std::vector<FaceRef> missing_squares_at(const TetMesh& mesh, const TetRegion& vo
 class SideClassifier {
  public:
   SideClassifier(const TriangleSurface& surface, const TriangleBVH& tree) : surface_(surface), tree_(tree) {
-    for (const auto& t : surface.triangles)
-      for (int k = 0; k < 3; ++k) edges_.push_back(make_edge(t[k], t[(k + 1) % 3]));
-    std::sort(edges_.begin(), edges_.end());
+    TopologyScratch scratch;
+    triangle_topology(surface.triangles, scratch);
+    rim_edges_ = std::move(scratch.boundary);
     rim_vertex_.assign(surface.points.size(), 0);
-    for (std::size_t i = 0; i < edges_.size();) {
-      std::size_t j = i + 1;
-      while (j < edges_.size() && edges_[j] == edges_[i]) ++j;
-      if (j - i == 1) {
-        rim_edges_.push_back(edges_[i]);
-        rim_vertex_[edges_[i].first] = rim_vertex_[edges_[i].second] = 1;
-      }
-      i = j;
-    }
+    for (const Edge& e : rim_edges_) rim_vertex_[e.first] = rim_vertex_[e.second] = 1;
   }
 
   int classify(const Eigen::Vector3d& x) const {
@@ -532,7 +513,7 @@ class SideClassifier {
 
   const TriangleSurface& surface_;
   const TriangleBVH& tree_;
-  std::vector<Edge> edges_, rim_edges_;
+  std::vector<Edge> rim_edges_;  // sorted
   std::vector<std::uint8_t> rim_vertex_;
 };
 
@@ -542,18 +523,20 @@ void clear_tag(TetMesh& mesh, FaceTag tag) {
       if (t == tag) t = no_face_tag;
 }
 
-// One healing attempt on one side; returns an empty string on success, else the reason of failure.
-std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier& sides, FaceTag tag, int side,
-                      const SurfaceApproximationOptions& options, const std::vector<TetRegion*>& other_regions,
-                      HealingStats& stats) {
-  clear_tag(mesh, tag);
-  // Sides of the boundary nodes of V_M, then the faces with three nodes on `side`.
+// The side of a node not classified yet.
+constexpr std::int8_t unknown_side = 2;
+
+// Classifies the boundary nodes of V_M into `node_side` (the others are left unknown) and tags the
+// boundary faces off the box with three nodes on `side`; returns an empty string, or the reason why
+// there are none.
+std::string tag_faces_on_side(TetMesh& mesh, const TetRegion& volumetric, const SideClassifier& sides, FaceTag tag,
+                              int side, std::vector<std::int8_t>& node_side, HealingStats& stats) {
   const VolumeBoundary boundary = read_volume_boundary(mesh, volumetric);
   std::vector<VertexId> nodes;
   for (const auto& f : boundary.nodes) nodes.insert(nodes.end(), f.begin(), f.end());
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-  std::vector<std::int8_t> node_side(mesh.points.size(), 0);
+  node_side.assign(mesh.points.size(), unknown_side);
   const auto count = static_cast<std::int64_t>(nodes.size());
 #pragma omp parallel for schedule(dynamic, 256)
   for (std::int64_t i = 0; i < count; ++i)
@@ -565,27 +548,99 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
       ++stats.initial_faces;
     }
   }
-  if (stats.initial_faces == 0) {
-    const bool touches_box = std::any_of(boundary.on_box.begin(), boundary.on_box.end(), [](std::uint8_t b) { return b; });
-    return touches_box ? "V_M reaches the box boundary on this side of S: the surface is too close to the box "
-                         "for this resolution"
-                       : "no boundary face of V_M has its three nodes on this side of S";
-  }
+  if (stats.initial_faces > 0) return {};
+  const bool touches_box = std::any_of(boundary.on_box.begin(), boundary.on_box.end(), [](std::uint8_t b) { return b; });
+  return touches_box ? "V_M reaches the box boundary on this side of S: the surface is too close to the box "
+                       "for this resolution"
+                     : "no boundary face of V_M has its three nodes on this side of S";
+}
 
+// Reflex rim corners already dealt with, sorted.
+struct ReflexCornerHistory {
+  std::vector<VertexId> left;    // could not be filled
+  std::vector<VertexId> filled;  // filled once
+};
+
+// A reflex rim corner (5 or more faces, fan over 180 degrees) is filled with the squares S_M lacks
+// there when those lie on this side of S or beyond its rim. Otherwise it is left as it is: the
+// paper removes it, but the notch a removal cuts has reflex corners of its own and grows until it
+// has eaten S_M (doc/results.md); a reflex fan only costs some squeezing at one rim node.
+// A node is filled once at most: a fill can make corbels whose removal brings the corner back.
+// Returns the number of faces added.
+std::int64_t fill_reflex_corners(TetMesh& mesh, const TetRegion& volumetric,
+                                 const std::vector<VertexId>& reflex_corners,
+                                 const std::function<std::int8_t(VertexId)>& side_of, FaceTag tag, int side,
+                                 ReflexCornerHistory& history, HealingStats& stats) {
+  if (reflex_corners.empty()) return 0;
+  std::int64_t filled_now = 0;
+  const VertexTets incidence = vertex_to_tets(mesh);
+  for (VertexId node : reflex_corners) {
+    if (std::binary_search(history.left.begin(), history.left.end(), node)) continue;
+    const auto missing = missing_squares_at(mesh, volumetric, incidence, node, tag);
+    const bool filled_before = std::binary_search(history.filled.begin(), history.filled.end(), node);
+    const bool can_fill = !filled_before && !missing.empty() && std::all_of(missing.begin(), missing.end(), [&](const FaceRef& f) {
+      const auto nodes_of_face = face_nodes(mesh, f.tet, f.local_face);
+      return std::all_of(nodes_of_face.begin(), nodes_of_face.end(), [&](VertexId v) { return side_of(v) != -side; });
+    });
+    if (can_fill) {
+      for (const FaceRef& f : missing) set_face_tag(mesh, f.tet, f.local_face, tag);
+      filled_now += static_cast<std::int64_t>(missing.size());
+      ++stats.reflex_corners_filled;
+      history.filled.insert(std::upper_bound(history.filled.begin(), history.filled.end(), node), node);
+    } else {
+      history.left.insert(std::upper_bound(history.left.begin(), history.left.end(), node), node);
+    }
+  }
+  return filled_now;
+}
+
+// The end of healing when S_M has no defect left to split: an empty string if it is a disk.
+std::string accept_disk(const TetMesh& mesh, const Interface& s, std::size_t reflex_corners_left, HealingStats& stats) {
+  SurfaceApproximationCheck check;
+  check_disk(mesh, s, check);
+  if (!check.is_disk()) return "S_M is not a disk: " + check.describe();
+  stats.faces = check.faces;
+  stats.rim_nodes = static_cast<std::int64_t>(s.rim_edges.size());
+  stats.reflex_corners_left = static_cast<std::int64_t>(reflex_corners_left);
+  return {};
+}
+
+// Bisects the tets with two faces of S_M and splits the defective edges, counting them in `stats`.
+void split_defects(TetMesh& mesh, const std::vector<TetRegion*>& regions, const std::vector<TetId>& doubled,
+                   std::vector<Edge> splits, const EdgeDefects& defects, HealingStats& stats) {
+  stats.tets_with_two_faces += static_cast<std::int64_t>(doubled.size());
+  stats.chord_edges += static_cast<std::int64_t>(defects.chords.size());
+  stats.triangles_with_two_rim_edges += static_cast<std::int64_t>(splits.size());
+  stats.cross_surface_edges += static_cast<std::int64_t>(defects.cross_surface.size());
+  stats.dividing_edges += static_cast<std::int64_t>(defects.dividing.size());
+  splits.insert(splits.end(), defects.cross_surface.begin(), defects.cross_surface.end());
+  splits.insert(splits.end(), defects.dividing.begin(), defects.dividing.end());
+  splits.insert(splits.end(), defects.chords.begin(), defects.chords.end());
+  std::sort(splits.begin(), splits.end());
+  splits.erase(std::unique(splits.begin(), splits.end()), splits.end());
+  EdgeSplitter splitter(mesh, regions);
+  if (!doubled.empty()) splitter.bisect(doubled);
+  for (const Edge& e : splits) splitter.split(e);
+}
+
+// One healing attempt on one side; returns an empty string on success, else the reason of failure.
+std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier& sides, FaceTag tag, int side,
+                      const SurfaceApproximationOptions& options, const std::vector<TetRegion*>& other_regions,
+                      HealingStats& stats) {
+  clear_tag(mesh, tag);
+  std::vector<std::int8_t> node_side;
+  if (std::string failure = tag_faces_on_side(mesh, volumetric, sides, tag, side, node_side, stats); !failure.empty())
+    return failure;
   // Sides of nodes created by refinement are computed when first needed.
-  constexpr std::int8_t unknown = 2;
   auto side_of = [&](VertexId v) {
-    if (static_cast<std::size_t>(v) >= node_side.size()) node_side.resize(mesh.points.size(), unknown);
-    if (node_side[v] == unknown) node_side[v] = static_cast<std::int8_t>(sides.classify(mesh.points[v]));
+    if (static_cast<std::size_t>(v) >= node_side.size()) node_side.resize(mesh.points.size(), unknown_side);
+    if (node_side[v] == unknown_side) node_side[v] = static_cast<std::int8_t>(sides.classify(mesh.points[v]));
     return node_side[v];
   };
-  for (VertexId v = 0; v < mesh.num_vertices(); ++v)
-    if (node_side[v] == 0 && !std::binary_search(nodes.begin(), nodes.end(), v)) node_side[v] = unknown;
 
   std::vector<TetRegion*> regions = other_regions;
   regions.push_back(&volumetric);
-  std::vector<VertexId> left_reflex;    // sorted: reflex rim corners that could not be filled
-  std::vector<VertexId> filled_reflex;  // sorted: reflex rim corners filled once
+  ReflexCornerHistory reflex_history;
   for (stats.passes = 1; stats.passes <= options.max_healing_passes; ++stats.passes) {
     const auto [stray, holes] = keep_one_component_without_holes(mesh, volumetric, tag);
     stats.stray_faces += stray;
@@ -599,69 +654,25 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
       remove_with_squares(mesh, s, corbels);
       continue;
     }
-    // A reflex rim corner (5 or more faces, fan over 180 degrees) is filled with the squares S_M lacks
-    // there when those lie on this side of S or beyond its rim. Otherwise it is left as it is: the
-    // paper removes it, but the notch a removal cuts has reflex corners of its own and grows until it
-    // has eaten S_M (doc/results.md); a reflex fan only costs some squeezing at one rim node.
-    // A node is filled once at most: a fill can make corbels whose removal brings the corner back.
     const std::vector<VertexId> reflex_corners = reflex_rim_corners(mesh, s);
-    std::int64_t filled_now = 0;
-    if (!reflex_corners.empty()) {
-      const VertexTets incidence = vertex_to_tets(mesh);
-      for (VertexId node : reflex_corners) {
-        if (std::binary_search(left_reflex.begin(), left_reflex.end(), node)) continue;
-        const auto missing = missing_squares_at(mesh, volumetric, incidence, node, tag);
-        const bool filled_before = std::binary_search(filled_reflex.begin(), filled_reflex.end(), node);
-        const bool can_fill = !filled_before && !missing.empty() && std::all_of(missing.begin(), missing.end(), [&](const FaceRef& f) {
-          const auto nodes_of_face = face_nodes(mesh, f.tet, f.local_face);
-          return std::all_of(nodes_of_face.begin(), nodes_of_face.end(), [&](VertexId v) { return side_of(v) != -side; });
-        });
-        if (can_fill) {
-          for (const FaceRef& f : missing) set_face_tag(mesh, f.tet, f.local_face, tag);
-          filled_now += static_cast<std::int64_t>(missing.size());
-          ++stats.reflex_corners_filled;
-          filled_reflex.insert(std::upper_bound(filled_reflex.begin(), filled_reflex.end(), node), node);
-        } else {
-          left_reflex.insert(std::upper_bound(left_reflex.begin(), left_reflex.end(), node), node);
-        }
-      }
-    }
-    if (filled_now > 0) {
-      stats.filled_faces += filled_now;
+    if (const std::int64_t filled =
+            fill_reflex_corners(mesh, volumetric, reflex_corners, side_of, tag, side, reflex_history, stats);
+        filled > 0) {
+      stats.filled_faces += filled;
       continue;
     }
 
     const std::vector<TetId> doubled = tets_with_two_faces(mesh, s);
     std::vector<Edge> splits = triangles_with_two_rim_edges(mesh, s);
-    const std::int64_t triangle_splits = static_cast<std::int64_t>(splits.size());
     const EdgeDefects defects = find_edge_defects(mesh, s, vertex_to_tets(mesh));
     if (defects.unfixable_nodes > 0)
       return std::to_string(defects.unfixable_nodes) +
              " node(s) of S_M lie on the box boundary or on another surface's S_M (the surface is too close "
              "to them for this resolution)";
     if (doubled.empty() && splits.empty() && defects.cross_surface.empty() && defects.dividing.empty() &&
-        defects.chords.empty()) {
-      SurfaceApproximationCheck check;
-      check_disk(mesh, s, check);
-      if (!check.is_disk()) return "S_M is not a disk: " + check.describe();
-      stats.faces = check.faces;
-      stats.rim_nodes = static_cast<std::int64_t>(s.rim_edges.size());
-      stats.reflex_corners_left = static_cast<std::int64_t>(reflex_corners.size());
-      return {};
-    }
-    stats.tets_with_two_faces += static_cast<std::int64_t>(doubled.size());
-    stats.chord_edges += static_cast<std::int64_t>(defects.chords.size());
-    stats.triangles_with_two_rim_edges += triangle_splits;
-    stats.cross_surface_edges += static_cast<std::int64_t>(defects.cross_surface.size());
-    stats.dividing_edges += static_cast<std::int64_t>(defects.dividing.size());
-    splits.insert(splits.end(), defects.cross_surface.begin(), defects.cross_surface.end());
-    splits.insert(splits.end(), defects.dividing.begin(), defects.dividing.end());
-    splits.insert(splits.end(), defects.chords.begin(), defects.chords.end());
-    std::sort(splits.begin(), splits.end());
-    splits.erase(std::unique(splits.begin(), splits.end()), splits.end());
-    EdgeSplitter splitter(mesh, regions);
-    if (!doubled.empty()) splitter.bisect(doubled);
-    for (const Edge& e : splits) splitter.split(e);
+        defects.chords.empty())
+      return accept_disk(mesh, s, reflex_corners.size(), stats);
+    split_defects(mesh, regions, doubled, std::move(splits), defects, stats);
   }
   return "healing did not converge in " + std::to_string(options.max_healing_passes) + " passes";
 }

@@ -232,35 +232,18 @@ void check_manifold_vertices(const TriangleSurface& surface, const std::vector<E
                     " and " + triangle_name(static_cast<std::size_t>(other_triangle)) + " are in different fans)");
 }
 
-void check_disk(const TriangleSurface& surface, const std::vector<EdgeSide>& sides) {
-  detail::UnionFind loops(surface.points.size());
-  std::vector<int> boundary_vertices;
-  long long edges = 0;
-  for_each_edge(sides, [&](std::size_t first, std::size_t count) {
-    ++edges;
-    if (count != 1) return;
-    loops.join(sides[first].low, sides[first].high);
-    boundary_vertices.push_back(sides[first].low);
-  });
-  if (boundary_vertices.empty())
+void check_disk(const TriangleSurface& surface) {
+  detail::TopologyScratch scratch;
+  const detail::TriangleTopology topology = detail::triangle_topology(surface.triangles, scratch);
+  if (topology.boundary_edges == 0)
     fail(surface, "closed surface (no boundary edges): an open surface with one boundary loop is required");
-  // Manifold vertices make the boundary a disjoint union of loops, one set of vertices per loop.
-  std::vector<int> loop_roots;
-  for (const int vertex : boundary_vertices) loop_roots.push_back(static_cast<int>(loops.find(vertex)));
-  std::ranges::sort(loop_roots);
-  const auto loop_count = std::ranges::distance(loop_roots.begin(), std::unique(loop_roots.begin(), loop_roots.end()));
-  if (loop_count != 1)
-    fail(surface, "not a topological disk: " + std::to_string(loop_count) +
+  if (topology.boundary_loops != 1)
+    fail(surface, "not a topological disk: " + std::to_string(topology.boundary_loops) +
                       " boundary loops (the surface has holes); exactly 1 is required");
-  std::vector<bool> used(surface.points.size(), false);
-  for (const Triangle& triangle : surface.triangles)
-    for (const int vertex : triangle) used[static_cast<std::size_t>(vertex)] = true;
-  const auto vertices = std::ranges::count(used, true);
-  const long long euler = vertices - edges + static_cast<long long>(surface.triangles.size());
-  if (euler != 1)
-    fail(surface, "not a topological disk: Euler characteristic V - E + F = " + std::to_string(vertices) + " - " +
-                      std::to_string(edges) + " + " + std::to_string(surface.triangles.size()) + " = " +
-                      std::to_string(euler) + " instead of 1 (the surface has handles)");
+  if (topology.euler() != 1)
+    fail(surface, "not a topological disk: Euler characteristic V - E + F = " + std::to_string(topology.vertices) +
+                      " - " + std::to_string(topology.edges) + " + " + std::to_string(topology.faces) + " = " +
+                      std::to_string(topology.euler()) + " instead of 1 (the surface has handles)");
 }
 
 }  // namespace
@@ -273,7 +256,7 @@ void require_surface_topology(const TriangleSurface& surface) {
   check_consistent_orientation(surface, sides);
   check_single_component(surface);
   check_manifold_vertices(surface, sides);
-  check_disk(surface, sides);
+  check_disk(surface);
 }
 
 }  // namespace meccano

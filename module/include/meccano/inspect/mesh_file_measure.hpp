@@ -74,8 +74,7 @@ struct InterfaceMeasure {
   std::optional<SurfaceAccuracy> accuracy;  // when a surface named NAME was given
 };
 
-// Thresholds of the low-quality counts, and their JSON keys.
-inline constexpr std::array<double, 3> low_quality_thresholds{0.1, 0.2, 0.3};
+// JSON keys of the low-quality counts (mesh/quality.hpp: low_quality_thresholds).
 inline constexpr std::array<const char*, 3> low_quality_keys{"below_0.1", "below_0.2", "below_0.3"};
 
 struct MeshMeasure {

@@ -15,8 +15,11 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -52,17 +55,64 @@ struct QualityStatistics {
 struct QualityHistogram {
   std::vector<std::int64_t> counts;  // bins of width 1/counts.size() over [0, 1]; q = 1 is in the last
 };
+// Thresholds of the low-quality counts.
+inline constexpr std::array<double, 3> low_quality_thresholds{0.1, 0.2, 0.3};
+
 struct QualitySummary {
   std::int64_t tets = 0;
   std::int64_t inverted = 0;      // tets with non-positive (or non-finite) signed volume
   QualityStatistics meccano;      // mean ratio against the computational counterpart (the paper's)
   QualityStatistics equilateral;  // mean ratio against the equilateral tet (Gmsh/TetGen's)
+  std::array<std::int64_t, 3> equilateral_below{};  // tets below each of low_quality_thresholds
   // Over the non-inverted tets; 0 and 180, the angles of a flat tet, when there are none.
   double min_dihedral_deg = 0, max_dihedral_deg = 0;
   QualityHistogram meccano_histogram, equilateral_histogram;
 };
 
-// Bit-identical for any number of OpenMP threads. An empty mesh gives zero statistics.
+// The summary built one tet at a time, for the tets of a TetMesh (summarize_quality) and for tets known
+// only by their points (a mesh file's, another mesher's), so that the same tets give the same figures.
+// Statistics are updated by Welford's rule and merged by Chan et al.'s: the spread of values that are all
+// nearly 1 survives, unlike with a sum of squares.
+class QualityAccumulator {
+ public:
+  // Throws std::invalid_argument if histogram_bins < 1.
+  explicit QualityAccumulator(int histogram_bins = 20);
+  // A tet's points in positive orientation and, if it has one, its meccano counterpart's; without one
+  // its meccano quality is its equilateral one.
+  void add(const TetPoints& physical, const TetPoints* computational = nullptr);
+  void merge(const QualityAccumulator& other);
+  QualitySummary summary() const;
+
+ private:
+  struct Moments {  // count, mean, sum of squared deviations and minimum
+    std::int64_t count = 0;
+    double mean = 0, squared_deviations = 0, min = std::numeric_limits<double>::infinity();
+
+    void add(double q) {
+      ++count;
+      const double delta = q - mean;
+      mean += delta / static_cast<double>(count);
+      squared_deviations += delta * (q - mean);
+      min = std::min(min, q);
+    }
+    void merge(const Moments& other);
+  };
+  void add_quality(double q_meccano, double q_equilateral);
+
+  Moments meccano_, equilateral_;
+  std::int64_t inverted_ = 0;
+  std::array<std::int64_t, 3> equilateral_below_{};
+  double largest_cosine_ = -1.0, smallest_cosine_ = 1.0;  // over the dihedral angles of valid tets
+  std::vector<std::int64_t> meccano_bins_, equilateral_bins_;
+};
+
+// The summary of tets 0 .. tet_count - 1, add_tet(t, accumulator) adding tet t. Fixed chunks of tets are
+// each summed alone, in parallel, and merged in chunk order: bit-identical for any number of threads.
+QualitySummary summarize_tet_quality(std::int64_t tet_count,
+                                     const std::function<void(std::int64_t, QualityAccumulator&)>& add_tet,
+                                     int histogram_bins = 20);
+
+// summarize_tet_quality over the mesh's tets. An empty mesh gives zero statistics.
 // Throws std::invalid_argument if histogram_bins < 1.
 QualitySummary summarize_quality(const TetMesh& mesh, int histogram_bins = 20);
 

@@ -136,14 +136,14 @@ struct TetMesh {
 // Exact orientation of the tet's vertex order in computational coordinates: +1, -1 or 0 (degenerate).
 int grid_orientation(const TetMesh& mesh, TetId t);
 
-// Every local face of every tet, keyed by its sorted vertices and sorted by key, so that the (at most two)
-// tets sharing a face are adjacent in the list.
+// Every local face of every tet, keyed by its sorted vertices and sorted by key, so that the tets sharing
+// a face are adjacent in the list. Takes the tets alone so that a mesh read from a file can be checked too.
 struct FaceRecord {
   std::array<VertexId, 3> key;
   TetId tet;
   int local_face;
 };
-std::vector<FaceRecord> sorted_face_records(const TetMesh& mesh);
+std::vector<FaceRecord> sorted_face_records(std::span<const std::array<VertexId, 4>> tets);
 
 // Fills `neighbours` from the tets alone. Throws MeshingError if a face is shared by more than two tets.
 void build_neighbours(TetMesh& mesh);

@@ -21,7 +21,7 @@ namespace meccano::tools {
 // The box of six numbers, the minimum corner first. A box the meccano cannot fill (box_defect) is a
 // malformed option: UsageError naming the option and the defect.
 inline Box box_from_numbers(const std::string& option, const std::array<double, 6>& v) {
-  const Box box{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+  Box box{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
   if (const std::string defect = box_defect(box); !defect.empty()) throw UsageError(option + ": " + defect);
   return box;
 }

@@ -318,7 +318,7 @@ TriangleBVH::TriangleBVH(const TriangleSurface& surface) : vertices_(surface.tri
   }
   order_.resize(n);
   std::iota(order_.begin(), order_.end(), 0);
-  nodes_.reserve(2 * (n / leaf_size + 1));
+  nodes_.reserve(std::size_t{2} * (n / leaf_size + 1));
   build(0, n, centroids, boxes);
   leaf_boxes_.reserve(n);
   for (int t : order_) leaf_boxes_.push_back(boxes[t]);
@@ -327,7 +327,7 @@ TriangleBVH::TriangleBVH(const TriangleSurface& surface) : vertices_(surface.tri
   face_normals_.reserve(n);
   vertex_normals_.assign(surface.points.size(), Vector3d::Zero());
   std::vector<std::tuple<int, int, int>> half_edges;  // (smaller vertex, larger vertex, 3 t + k)
-  half_edges.reserve(3 * n);
+  half_edges.reserve(std::size_t{3} * n);
   for (int t = 0; t < n; ++t) {
     const Triangle3& c = corners_[t];
     const Vector3d normal = (c[1] - c[0]).cross(c[2] - c[0]).normalized();
@@ -341,7 +341,7 @@ TriangleBVH::TriangleBVH(const TriangleSurface& surface) : vertices_(surface.tri
     }
   }
   std::sort(half_edges.begin(), half_edges.end());
-  edge_normals_.assign(3 * n, Vector3d::Zero());
+  edge_normals_.assign(std::size_t{3} * n, Vector3d::Zero());
   for (std::size_t begin = 0; begin < half_edges.size();) {
     std::size_t end = begin;
     Vector3d sum = Vector3d::Zero();

@@ -16,7 +16,6 @@ namespace {
 
 using detail::Edge;
 using detail::edges_with_triangles;
-using detail::make_edge;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 

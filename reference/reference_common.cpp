@@ -66,9 +66,7 @@ void parse_arguments(int argc, char** argv, const char* usage_text, CommonOption
   check_common_options(common);
 }
 
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 void check_outputs_writable(const CommonOptions& options) {
   require_writable(options.output);
@@ -99,10 +97,15 @@ MeshSummary summarize_tets(std::size_t tet_count, std::size_t node_count,
       max_volume = std::max(max_volume, volume);
   }
   const QualitySummary summary = quality.summary();
-  return {.tets = tet_count, .nodes = node_count, .inverted = static_cast<std::size_t>(summary.inverted),
-          .min_mean_ratio = summary.equilateral.min, .mean_mean_ratio = summary.equilateral.mean,
-          .std_mean_ratio = summary.equilateral.std, .min_dihedral_deg = summary.min_dihedral_deg,
-          .max_dihedral_deg = summary.max_dihedral_deg, .max_volume = max_volume};
+  return {.tets = tet_count,
+          .nodes = node_count,
+          .inverted = static_cast<std::size_t>(summary.inverted),
+          .min_mean_ratio = summary.equilateral.min,
+          .mean_mean_ratio = summary.equilateral.mean,
+          .std_mean_ratio = summary.equilateral.std,
+          .min_dihedral_deg = summary.min_dihedral_deg,
+          .max_dihedral_deg = summary.max_dihedral_deg,
+          .max_volume = max_volume};
 }
 
 std::string describe(const MeshSummary& summary) {
@@ -118,26 +121,42 @@ void write_report(const ReferenceRun& run, const std::function<void(JsonWriter&)
   JsonWriter json;
   json.begin_object().key("tool").value(run.tool);
   tool_keys(json);
-  json.key("size").value(run.size)
-      .key("tets").value(run.mesh.tets)
-      .key("nodes").value(run.mesh.nodes)
-      .key("inverted").value(run.mesh.inverted)
-      .key("max_tet_volume").value(run.mesh.max_volume)
-      .key("interface_triangles").begin_object();
+  json.key("size")
+      .value(run.size)
+      .key("tets")
+      .value(run.mesh.tets)
+      .key("nodes")
+      .value(run.mesh.nodes)
+      .key("inverted")
+      .value(run.mesh.inverted)
+      .key("max_tet_volume")
+      .value(run.mesh.max_volume)
+      .key("interface_triangles")
+      .begin_object();
   for (const auto& [name, count] : run.interface_triangles) json.key(name).value(count);
   json.end_object()
-      .key("seconds").begin_object()
-      .key("meshing").value(run.meshing_seconds)
-      .key("total").value(total_seconds)
+      .key("seconds")
+      .begin_object()
+      .key("meshing")
+      .value(run.meshing_seconds)
+      .key("total")
+      .value(total_seconds)
       .end_object()
-      .key("quality").begin_object()
-      .key("equilateral").begin_object()
-      .key("min").value(run.mesh.min_mean_ratio)
-      .key("mean").value(run.mesh.mean_mean_ratio)
-      .key("std").value(run.mesh.std_mean_ratio)
+      .key("quality")
+      .begin_object()
+      .key("equilateral")
+      .begin_object()
+      .key("min")
+      .value(run.mesh.min_mean_ratio)
+      .key("mean")
+      .value(run.mesh.mean_mean_ratio)
+      .key("std")
+      .value(run.mesh.std_mean_ratio)
       .end_object()
-      .key("min_dihedral_deg").value(run.mesh.min_dihedral_deg)
-      .key("max_dihedral_deg").value(run.mesh.max_dihedral_deg)
+      .key("min_dihedral_deg")
+      .value(run.mesh.min_dihedral_deg)
+      .key("max_dihedral_deg")
+      .value(run.mesh.max_dihedral_deg)
       .end_object()
       .end_object();
   write_file_atomically(path, [&](std::ostream& out) { out << json.str(); });

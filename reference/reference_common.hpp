@@ -16,10 +16,10 @@
 //           atomically; each tool adds its own keys after "tool".
 #pragma once
 
-#include <meccano/mesh/box.hpp>
-#include <meccano/report/json_writer.hpp>
-#include <meccano/mesh/quality.hpp>
 #include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/box.hpp>
+#include <meccano/mesh/quality.hpp>
+#include <meccano/report/json_writer.hpp>
 
 #include "arguments.hpp"
 #include "tool_support.hpp"
@@ -75,7 +75,7 @@ struct MeshSummary {
   // Equilateral mean ratio over all tets, an inverted one counting as 0; std is the population's.
   double min_mean_ratio = 0.0, mean_mean_ratio = 0.0, std_mean_ratio = 0.0;
   double min_dihedral_deg = 180.0, max_dihedral_deg = 0.0;  // over the tets that are not inverted
-  double max_volume = 0.0;                                   // the largest tet's volume
+  double max_volume = 0.0;                                  // the largest tet's volume
 };
 
 // Quality of tets 0 .. tet_count - 1, tet t having the corners points_of_tet(t) in the file's order,

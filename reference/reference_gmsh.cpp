@@ -22,8 +22,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
 #include <limits>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -32,7 +32,8 @@
 
 namespace {
 
-constexpr const char* usage_text = R"(Usage: reference-gmsh --box XMIN YMIN ZMIN XMAX YMAX ZMAX --surface FILE[:NAME] [--surface ...]
+constexpr const char* usage_text =
+    R"(Usage: reference-gmsh --box XMIN YMIN ZMIN XMAX YMAX ZMAX --surface FILE[:NAME] [--surface ...]
                       --size H --output FILE.msh [options]
 
 Builds the reference tetrahedral mesh that meccano-immerse is compared with: Gmsh 3D meshes the box
@@ -192,7 +193,8 @@ BoxEntities add_box(const meccano::Box& box, double h) {
   std::map<std::pair<int, int>, int> line_of_edge;  // (from corner, to corner) with from < to
   for (int c = 0; c < 8; ++c)
     for (int k = 0; k < 3; ++k)
-      if (!(c >> k & 1)) line_of_edge[{c, c | 1 << k}] = gmsh::model::geo::addLine(corner_tags[c], corner_tags[c | 1 << k]);
+      if (!(c >> k & 1))
+        line_of_edge[{c, c | 1 << k}] = gmsh::model::geo::addLine(corner_tags[c], corner_tags[c | 1 << k]);
   const auto oriented_line = [&](int from, int to) {
     return from < to ? line_of_edge.at({from, to}) : -line_of_edge.at({to, from});
   };
@@ -204,8 +206,9 @@ BoxEntities add_box(const meccano::Box& box, double h) {
       const int a = (k + 1) % 3, b = (k + 2) % 3, base = at_max << k;
       std::array<int, 4> quad{base, base | 1 << a, base | 1 << a | 1 << b, base | 1 << b};
       if (!at_max) std::reverse(quad.begin(), quad.end());
-      const int loop = gmsh::model::geo::addCurveLoop({oriented_line(quad[0], quad[1]), oriented_line(quad[1], quad[2]),
-                                                       oriented_line(quad[2], quad[3]), oriented_line(quad[3], quad[0])});
+      const int loop =
+          gmsh::model::geo::addCurveLoop({oriented_line(quad[0], quad[1]), oriented_line(quad[1], quad[2]),
+                                          oriented_line(quad[2], quad[3]), oriented_line(quad[3], quad[0])});
       entities.sides[2 * k + at_max] = gmsh::model::geo::addPlaneSurface({loop});
     }
   const int shell = gmsh::model::geo::addSurfaceLoop({entities.sides.begin(), entities.sides.end()});
@@ -273,14 +276,18 @@ void write_report(const meccano::reference::ReferenceRun& run, const Options& op
   meccano::reference::write_report(
       run,
       [&](meccano::JsonWriter& json) {
-        json.key("gmsh_version").value(version)
-            .key("algorithm").value(options.algorithm == Algorithm::hxt ? "hxt" : "delaunay")
-            .key("threads").value(options.threads);
-        if (options.size_field)
-          json.key("size_near_surface").value(options.size_field->near_surface)
-              .key("size_distance").value(options.size_field->distance);
-        else
-          json.key("size_near_surface").null().key("size_distance").null();
+    json.key("gmsh_version")
+        .value(version)
+        .key("algorithm")
+        .value(options.algorithm == Algorithm::hxt ? "hxt" : "delaunay")
+        .key("threads")
+        .value(options.threads);
+    if (options.size_field)
+      json.key("size_near_surface")
+          .value(options.size_field->near_surface)
+          .key("size_distance")
+          .value(options.size_field->distance);
+    else json.key("size_near_surface").null().key("size_distance").null();
       },
       total_seconds, path);
 }
@@ -338,13 +345,14 @@ int run(const Options& options) {
     add_named_group(2, {box.sides[side]}, meccano::box_side_tag(box_side), meccano::box_side_name(box_side));
   }
   for (std::size_t s = 0; s < surfaces.size(); ++s)
-    add_named_group(2, {surface_entities[s]}, meccano::interface_tag(static_cast<int>(s)), "interface_" + surfaces[s].name);
+    add_named_group(2, {surface_entities[s]}, meccano::interface_tag(static_cast<int>(s)),
+                    "interface_" + surfaces[s].name);
 
   if (options.size_field)
     progress.say("gmsh: size field: ", options.size_field->near_surface, " at the surfaces, growing to ", *common.size,
                  " at distance ", options.size_field->distance);
-  progress.say("gmsh: meshing with ", options.algorithm == Algorithm::hxt ? "HXT" : "Delaunay", ", size ",
-               *common.size, ", ", options.threads, " thread(s)");
+  progress.say("gmsh: meshing with ", options.algorithm == Algorithm::hxt ? "HXT" : "Delaunay", ", size ", *common.size,
+               ", ", options.threads, " thread(s)");
   const auto meshing_start = Clock::now();
   gmsh::model::mesh::generate(3);
   const double meshing_seconds = meccano::reference::seconds_since(meshing_start);
@@ -361,7 +369,7 @@ int run(const Options& options) {
     interface_triangles.emplace_back(surfaces[s].name, element_tags.size());
   }
   const meccano::reference::ReferenceRun record{"reference-gmsh", *common.size, std::move(interface_triangles),
-                                               summarize_mesh(), meshing_seconds};
+                                                summarize_mesh(), meshing_seconds};
   progress.say("gmsh: ", meccano::reference::describe(record.mesh), " in ", record.meshing_seconds, " s");
 
   meccano::reference::write_outputs(common, progress, write_gmsh_msh, [&](const std::string& path) {

@@ -17,9 +17,9 @@
 
 #include "reference_common.hpp"
 
-#include <meccano/io/atomic_file.hpp>
 #include <meccano/error.hpp>
 #include <meccano/geometry/geometry.hpp>
+#include <meccano/io/atomic_file.hpp>
 #include <meccano/mesh/tet_mesh.hpp>
 
 // Declares tetrahedralize(char* switches, ...); Debian's libtet is built with it, so every TetGen
@@ -41,7 +41,8 @@
 
 namespace {
 
-constexpr const char* usage_text = R"(Usage: reference-tetgen --box XMIN YMIN ZMIN XMAX YMAX ZMAX --surface FILE[:NAME] [--surface ...]
+constexpr const char* usage_text =
+    R"(Usage: reference-tetgen --box XMIN YMIN ZMIN XMAX YMAX ZMAX --surface FILE[:NAME] [--surface ...]
                         --size H --output FILE.msh [options]
 
 Builds a reference tetrahedral mesh for meccano-immerse: TetGen 1.5 meshes the box with the surfaces as
@@ -206,13 +207,16 @@ void fill_plc(const meccano::Box& box, const std::vector<meccano::TriangleSurfac
 std::string tetgen_failure(int code) {
   switch (code) {
     case 1: return "TetGen ran out of memory (try a larger --size)";
-    case 2: return "TetGen hit an internal error (a TetGen bug; a slightly different --size or --radius-edge may "
-                   "avoid it)";
-    case 3: return "TetGen found a self-intersection in the input, closer than its tolerance although the surfaces "
-                   "passed meccano's checks";
+    case 2:
+      return "TetGen hit an internal error (a TetGen bug; a slightly different --size or --radius-edge may "
+             "avoid it)";
+    case 3:
+      return "TetGen found a self-intersection in the input, closer than its tolerance although the surfaces "
+             "passed meccano's checks";
     case 4: return "TetGen found an input feature (edge, gap) smaller than its relative tolerance 1e-8";
-    case 5: return "TetGen found two input facets very close to each other (--keep-surface avoids the Steiner points "
-                   "that cause this)";
+    case 5:
+      return "TetGen found two input facets very close to each other (--keep-surface avoids the Steiner points "
+             "that cause this)";
     case 10: return "TetGen rejected the input as invalid";
     default: return "TetGen failed with code " + std::to_string(code);
   }
@@ -220,7 +224,7 @@ std::string tetgen_failure(int code) {
 
 // The mesh as TetGen returns it, with each face group in meccano's orientation.
 struct ReferenceMesh {
-  tetgenio tetgen;                                       // points and tets as TetGen made them
+  tetgenio tetgen;                                      // points and tets as TetGen made them
   std::vector<std::vector<std::array<int, 3>>> groups;  // faces of marker m at m - 1: box sides, then surfaces
 };
 
@@ -342,13 +346,13 @@ int run(const Options& options) {
   std::vector<std::pair<std::string, std::size_t>> interface_triangles;
   for (std::size_t s = 0; s < surfaces.size(); ++s)
     interface_triangles.emplace_back(surfaces[s].name, mesh.groups[6 + s].size());
-  const auto summary = meccano::reference::summarize_tets(
-      static_cast<std::size_t>(out.numberoftetrahedra), static_cast<std::size_t>(out.numberofpoints),
-      [&](std::size_t t) {
-        meccano::TetPoints p;
-        for (std::size_t i = 0; i < 4; ++i) p[i] = point(out, out.tetrahedronlist[4 * t + i] - out.firstnumber);
-        return p;
-      });
+  const auto summary = meccano::reference::summarize_tets(static_cast<std::size_t>(out.numberoftetrahedra),
+                                                          static_cast<std::size_t>(out.numberofpoints),
+                                                          [&](std::size_t t) {
+    meccano::TetPoints p;
+    for (std::size_t i = 0; i < 4; ++i) p[i] = point(out, out.tetrahedronlist[4 * t + i] - out.firstnumber);
+    return p;
+  });
   const meccano::reference::ReferenceRun record{"reference-tetgen", *common.size, std::move(interface_triangles),
                                                 summary, meshing_seconds};
   progress.say("tetgen: ", meccano::reference::describe(record.mesh), " in ", record.meshing_seconds, " s");
@@ -359,17 +363,15 @@ int run(const Options& options) {
   meccano::reference::write_outputs(
       common, progress, [&](const std::string& path) { write_msh41(mesh, surfaces, common.box, path); },
       [&](const std::string& path) {
-        meccano::reference::write_report(
-            record,
-            [&](meccano::JsonWriter& json) {
-              json.key("switches").value(switches)
-                  .key("radius_edge").value(options.radius_edge);
-              if (options.min_dihedral_deg) json.key("min_dihedral_bound_deg").value(*options.min_dihedral_deg);
-              else json.key("min_dihedral_bound_deg").null();
-              json.key("keep_surface").value(options.keep_surface)
-                  .key("volume_bound").value(regular_tet_volume(*common.size));
-            },
-            meccano::reference::seconds_since(start), path);
+    meccano::reference::write_report(
+        record,
+        [&](meccano::JsonWriter& json) {
+      json.key("switches").value(switches).key("radius_edge").value(options.radius_edge);
+      if (options.min_dihedral_deg) json.key("min_dihedral_bound_deg").value(*options.min_dihedral_deg);
+      else json.key("min_dihedral_bound_deg").null();
+      json.key("keep_surface").value(options.keep_surface).key("volume_bound").value(regular_tet_volume(*common.size));
+        },
+        meccano::reference::seconds_since(start), path);
       });
   return 0;
 }

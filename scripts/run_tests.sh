@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# Set up the machine, build with warnings as errors (MECCANO_WERROR), and run the whole test suite with
-# CTest (every label: unit, pipeline, long); then the quick sanitized subset (ASan + UBSan,
+# Set up the machine, check the C++ formatting (scripts/check_format.sh), build with warnings as errors
+# (MECCANO_WERROR), and run the whole test suite with CTest (every label: unit, pipeline, long; the
+# layering check is a unit test); then the quick sanitized subset (ASan + UBSan,
 # scripts/run_sanitized_tests.sh --quick) and a short fuzzing run of the surface readers and the
 # validation (20 s per target) when clang and libFuzzer are available.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
+scripts/check_format.sh
 MECCANO_WERROR=ON scripts/build.sh
 ctest --test-dir build -j"$(nproc)" --output-on-failure
 scripts/run_sanitized_tests.sh --quick build-asan

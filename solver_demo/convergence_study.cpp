@@ -123,10 +123,10 @@ void study(MPI_Comm communicator, const Options& options) {
     const Row* previous = rows.empty() ? nullptr : &rows.back();
     const Row row{report.h, report.cells, report.dofs, *report.l2_error, *report.h1_error, normals.max_deg, seconds};
     std::printf("%2d %6.4f %4d %6.4f %8llu %8llu %3u %.3e %5s %.3e %5s %4.1f/%3.1f %6.1f %6.1f %6.1f %6.1f %6.1f\n",
-                level.base_level, level.resolution, level.surface_cells, row.h, row.tets, row.dofs, report.cg_iterations,
-                row.l2_error, rate_text(row.l2_error, row.h, previous, &Row::l2_error).c_str(), row.h1_error,
-                rate_text(row.h1_error, row.h, previous, &Row::h1_error).c_str(), normals.max_deg, normals.mean_deg,
-                mesh_seconds, report.setup_seconds, report.assembly_seconds, report.solve_seconds,
+                level.base_level, level.resolution, level.surface_cells, row.h, row.tets, row.dofs,
+                report.cg_iterations, row.l2_error, rate_text(row.l2_error, row.h, previous, &Row::l2_error).c_str(),
+                row.h1_error, rate_text(row.h1_error, row.h, previous, &Row::h1_error).c_str(), normals.max_deg,
+                normals.mean_deg, mesh_seconds, report.setup_seconds, report.assembly_seconds, report.solve_seconds,
                 report.postprocess_seconds);
     std::fflush(stdout);
     rows.push_back(row);

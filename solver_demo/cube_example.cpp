@@ -26,10 +26,8 @@ struct Height {
 Height height(double x, double y) {
   const double p = (x - origin) / side, q = (y - origin) / side;
   const double sp = std::sin(pi * p), cp = std::cos(pi * p), sq = std::sin(pi * q), cq = std::cos(pi * q);
-  return {base + tilt * p * q + bump * sp * sq,
-          (tilt * q + bump * pi * cp * sq) / side,
-          (tilt * p + bump * pi * sp * cq) / side,
-          -2.0 * bump * pi * pi * sp * sq / (side * side)};
+  return {base + tilt * p * q + bump * sp * sq, (tilt * q + bump * pi * cp * sq) / side,
+          (tilt * p + bump * pi * sp * cq) / side, -2.0 * bump * pi * pi * sp * sq / (side * side)};
 }
 
 // The cutoff w = B³, B = 16 p(1−p) q(1−q) on Q and 0 outside. B vanishes linearly at the rim, so w

@@ -30,8 +30,8 @@ struct ValueAndGradient {
   Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
 };
 
-double cube_example_height(double x, double y);               // s(x, y)
-Eigen::Vector3d cube_example_normal(double x, double y);      // unit, towards +z
+double cube_example_height(double x, double y);           // s(x, y)
+Eigen::Vector3d cube_example_normal(double x, double y);  // unit, towards +z
 
 ValueAndGradient manufactured_solution(const Eigen::Vector3d& p);  // u and ∇u (one-sided on S)
 double manufactured_right_hand_side(const Eigen::Vector3d& p);     // f = −Δu off S
@@ -55,8 +55,8 @@ SurfaceMatch match_cube_example_surface(const meccano::DealiiInterface& interfac
 // unoriented lines (a triangle's orientation is a property of the file, not of the approximation).
 struct NormalError {
   double max_deg = 0.0;
-  double mean_deg = 0.0;                   // area-weighted
-  std::vector<double> per_triangle_deg;    // in the order of the interface's triangles
+  double mean_deg = 0.0;                 // area-weighted
+  std::vector<double> per_triangle_deg;  // in the order of the interface's triangles
 };
 NormalError cube_example_normal_error(const meccano::DealiiInterface& interface);
 

@@ -42,8 +42,11 @@ InterfaceProblem manufactured_problem() {
 
 InterfaceProblem unit_source_problem() {
   const auto zero = [](const Eigen::Vector3d&) { return 0.0; };
-  return {"-Δu = 0, u = 0 on the box sides, unit flux jump on S", zero, zero,
-          [](const Eigen::Vector3d&) { return 1.0; }, {}};
+  return {"-Δu = 0, u = 0 on the box sides, unit flux jump on S",
+          zero,
+          zero,
+          [](const Eigen::Vector3d&) { return 1.0; },
+          {}};
 }
 
 namespace {
@@ -118,8 +121,8 @@ void InterfacePoisson::make_grid(const meccano::DealiiMesh& mesh, const std::str
   report.h = Utilities::MPI::max(h, communicator);
   report.interface_faces = Utilities::MPI::sum<unsigned long long>(interface_faces.size(), communicator);
   if (report.interface_faces != interface.triangles())
-    throw std::logic_error("the distributed mesh has " + std::to_string(report.interface_faces) + " faces on S, the input " +
-                           std::to_string(interface.triangles()));
+    throw std::logic_error("the distributed mesh has " + std::to_string(report.interface_faces) +
+                           " faces on S, the input " + std::to_string(interface.triangles()));
 }
 
 // Degrees of freedom, the Dirichlet constraints u = g_D on every boundary face (S's faces are interior)
@@ -178,7 +181,8 @@ void InterfacePoisson::assemble_system() {
   }
 
   const QGaussSimplex<2> face_quadrature(fe.degree + 2);
-  FEFaceValues<3> fe_face_values(mapping, fe, face_quadrature, update_values | update_quadrature_points | update_JxW_values);
+  FEFaceValues<3> fe_face_values(mapping, fe, face_quadrature,
+                                 update_values | update_quadrature_points | update_JxW_values);
   for (const meccano::InterfaceCellFace& face : interface_faces) {
     const DoFHandler<3>::active_cell_iterator cell(&triangulation, face.negative->level(), face.negative->index(),
                                                    &dof_handler);
@@ -221,8 +225,9 @@ void InterfacePoisson::evaluate() {
   FEValues<3> fe_values(mapping, fe, quadrature,
                         update_values | update_gradients | update_quadrature_points | update_JxW_values);
   const QGaussSimplex<2> face_quadrature(fe.degree + 2);
-  FEFaceValues<3> fe_face_values(mapping, fe, face_quadrature,
-                                 update_gradients | update_normal_vectors | update_quadrature_points | update_JxW_values);
+  FEFaceValues<3> fe_face_values(
+      mapping, fe, face_quadrature,
+      update_gradients | update_normal_vectors | update_quadrature_points | update_JxW_values);
   std::vector<double> values(quadrature.size());
   std::vector<Tensor<1, 3>> gradients(quadrature.size()), face_gradients(face_quadrature.size());
 
@@ -303,7 +308,8 @@ void InterfacePoisson::output_results(const std::string& prefix) const {
     std::vector<std::string> pieces;
     const std::string stem = prefix.substr(prefix.find_last_of('/') + 1);
     for (unsigned int r = 0; r < ranks; ++r) pieces.push_back(stem + "." + std::to_string(r) + ".vtu");
-    meccano::write_file_atomically(prefix + ".pvtu", [&](std::ostream& out) { data_out.write_pvtu_record(out, pieces); });
+    meccano::write_file_atomically(prefix + ".pvtu",
+                                   [&](std::ostream& out) { data_out.write_pvtu_record(out, pieces); });
   }
 }
 
@@ -334,7 +340,8 @@ SolveReport InterfacePoisson::run(const meccano::DealiiMesh& mesh, const std::st
 SolveReport solve_interface_problem(MPI_Comm communicator, const meccano::DealiiMesh& mesh,
                                     const std::string& interface_name, unsigned int degree,
                                     const InterfaceProblem& problem, const std::string& vtu_prefix) {
-  if (degree != 1 && degree != 2) throw std::invalid_argument("the degree must be 1 or 2, not " + std::to_string(degree));
+  if (degree != 1 && degree != 2)
+    throw std::invalid_argument("the degree must be 1 or 2, not " + std::to_string(degree));
   InterfacePoisson solver(communicator, degree, problem);
   return solver.run(mesh, interface_name, vtu_prefix);
 }

@@ -34,9 +34,9 @@ namespace solver_demo {
 
 struct InterfaceProblem {
   std::string description;
-  std::function<double(const Eigen::Vector3d&)> right_hand_side;   // f
-  std::function<double(const Eigen::Vector3d&)> boundary_values;   // g_D
-  std::function<double(const Eigen::Vector3d&)> interface_source;  // g_S
+  std::function<double(const Eigen::Vector3d&)> right_hand_side;           // f
+  std::function<double(const Eigen::Vector3d&)> boundary_values;           // g_D
+  std::function<double(const Eigen::Vector3d&)> interface_source;          // g_S
   std::function<ValueAndGradient(const Eigen::Vector3d&)> exact_solution;  // empty when unknown
 };
 
@@ -55,13 +55,13 @@ struct SolveReport {
   // by the discrete gradient, −∫_∂Ω ∇u_h·n. Equal for the exact solution; they agree as h → 0.
   double source = 0.0;
   double outflow = 0.0;
-  double l2_norm = 0.0;      // ‖u_h‖_L2
-  double h1_seminorm = 0.0;  // ‖∇u_h‖_L2
+  double l2_norm = 0.0;            // ‖u_h‖_L2
+  double h1_seminorm = 0.0;        // ‖∇u_h‖_L2
   std::optional<double> l2_error;  // ‖u − u_h‖_L2
   std::optional<double> h1_error;  // ‖∇(u − u_h)‖_L2
   double setup_seconds = 0.0;      // distributed mesh, dofs, constraints, sparsity
   double assembly_seconds = 0.0;
-  double solve_seconds = 0.0;      // AMG setup and CG
+  double solve_seconds = 0.0;  // AMG setup and CG
   double postprocess_seconds = 0.0;
 };
 

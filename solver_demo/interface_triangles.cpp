@@ -9,8 +9,7 @@ namespace solver_demo {
 
 double interface_area(const meccano::DealiiInterface& interface) {
   double area = 0.0;
-  for (std::size_t t = 0; t < interface.triangles(); ++t)
-    area += 0.5 * triangle_normal(interface, t).norm();
+  for (std::size_t t = 0; t < interface.triangles(); ++t) area += 0.5 * triangle_normal(interface, t).norm();
   return area;
 }
 

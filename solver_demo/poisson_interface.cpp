@@ -5,8 +5,8 @@
 #include "cube_example.hpp"
 #include "interface_poisson.hpp"
 
-#include <meccano/io/atomic_file.hpp>
 #include <meccano/error.hpp>
+#include <meccano/io/atomic_file.hpp>
 #include <meccano/report/json_writer.hpp>
 
 #include <deal.II/base/mpi.h>
@@ -21,7 +21,8 @@ namespace {
 
 using namespace solver_demo;
 
-constexpr const char* usage = R"(Usage: poisson_interface --mesh FILE.msh [--interface NAME] [--degree 1|2] [--vtu PREFIX]
+constexpr const char* usage =
+    R"(Usage: poisson_interface --mesh FILE.msh [--interface NAME] [--degree 1|2] [--vtu PREFIX]
                          [--report FILE.json]
 
 Solves -Δu = f in the mesh's domain, u = g_D on its boundary, with the flux jump
@@ -120,8 +121,8 @@ void solve(MPI_Comm communicator, const Options& options) {
   const meccano::DealiiInterface& surface = *interface;
   std::vector<TriangleField> fields;
   std::optional<NormalError> normals;
-  std::cout << std::setprecision(4) << "mesh        " << options.at("--mesh") << ": " << report.cells << " tets, h = "
-            << report.h << " (longest edge); interface_" << surface.name << ": " << surface.triangles()
+  std::cout << std::setprecision(4) << "mesh        " << options.at("--mesh") << ": " << report.cells
+            << " tets, h = " << report.h << " (longest edge); interface_" << surface.name << ": " << surface.triangles()
             << " triangles, area " << interface_area(surface) << '\n';
   if (manufactured) {
     normals = cube_example_normal_error(surface);
@@ -131,13 +132,14 @@ void solve(MPI_Comm communicator, const Options& options) {
               << "normals     angle to S's normal: max " << normals->max_deg << " deg, mean " << normals->mean_deg
               << " deg (area-weighted)\n";
   } else {
-    std::cout << "surface     not the cube example's (nodes up to " << match.max_deviation << " off its formula, tolerance "
-              << match.tolerance << "): f = 0, g_D = 0, g_S = 1\n";
+    std::cout << "surface     not the cube example's (nodes up to " << match.max_deviation
+              << " off its formula, tolerance " << match.tolerance << "): f = 0, g_D = 0, g_S = 1\n";
   }
   std::cout << "system      P" << degree << ", " << report.dofs << " dofs, " << report.interface_faces
             << " faces on S, CG + AMG: " << report.cg_iterations << " iterations\n"
             << std::setprecision(12) << std::scientific;
-  if (report.l2_error) std::cout << "L2 error    " << *report.l2_error << '\n' << "H1 error    " << *report.h1_error << '\n';
+  if (report.l2_error)
+    std::cout << "L2 error    " << *report.l2_error << '\n' << "H1 error    " << *report.h1_error << '\n';
   std::cout << "norms       L2 " << report.l2_norm << ", H1 seminorm " << report.h1_seminorm << '\n'
             << "source      " << report.source << "  (int_Omega f + int_S g_S)\n"
             << "outflow     " << report.outflow << "  (-int_boundary grad u_h . n)\n"
@@ -148,7 +150,8 @@ void solve(MPI_Comm communicator, const Options& options) {
 
   if (!vtu.empty()) {
     std::vector<double> source;
-    for (std::size_t t = 0; t < surface.triangles(); ++t) source.push_back(problem.interface_source(centroid(surface, t)));
+    for (std::size_t t = 0; t < surface.triangles(); ++t)
+      source.push_back(problem.interface_source(centroid(surface, t)));
     fields.emplace_back("g_S", std::move(source));
     write_interface_vtu(surface, fields, vtu + "_interface.vtu");
   }

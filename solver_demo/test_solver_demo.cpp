@@ -6,11 +6,11 @@
 #include "cube_example.hpp"
 #include "interface_triangles.hpp"
 
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
 #include <meccano/io/mesh_writers.hpp>
-#include <meccano/stages/pipeline.hpp>
 #include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/stages/pipeline.hpp>
 
 #include <run_command.hpp>
 #include <scratch_directory.hpp>
@@ -79,9 +79,11 @@ TEST(ManufacturedSolution, RightHandSideIsMinusTheLaplacian) {
     for (int k = 0; k < 3; ++k) {
       const Vector3d e = step * Vector3d::Unit(k);
       laplacian += (manufactured_solution(p + e).value - 2.0 * manufactured_solution(p).value +
-                    manufactured_solution(p - e).value) / (step * step);
+                    manufactured_solution(p - e).value) /
+                   (step * step);
     }
-    EXPECT_NEAR(manufactured_right_hand_side(p), -laplacian, 1e-4 * (1.0 + std::abs(laplacian))) << "at " << p.transpose();
+    EXPECT_NEAR(manufactured_right_hand_side(p), -laplacian, 1e-4 * (1.0 + std::abs(laplacian)))
+        << "at " << p.transpose();
   }
 }
 
@@ -113,7 +115,8 @@ TEST(ManufacturedSolution, KinkFadesOutAtTheRim) {
     for (const double z : {0.1, 0.47, 0.9}) {
       const double y = 0.2 + 0.6 * t;
       for (const double wall : {0.2, 0.8}) {
-        const Vector3d inside(wall + (wall < 0.5 ? step : -step), y, z), outside(wall + (wall < 0.5 ? -step : step), y, z);
+        const Vector3d inside(wall + (wall < 0.5 ? step : -step), y, z),
+            outside(wall + (wall < 0.5 ? -step : step), y, z);
         EXPECT_NEAR(manufactured_solution(inside).value, manufactured_solution(outside).value, 1e-8);
         EXPECT_LT((manufactured_solution(inside).gradient - manufactured_solution(outside).gradient).norm(), 1e-7);
         EXPECT_NEAR(manufactured_right_hand_side(inside), manufactured_right_hand_side(outside), 1e-6);
@@ -144,7 +147,8 @@ using meccano::testing::run_command;
 meccano::InsertionResult insert(const meccano::TriangleSurface& surface, int level, double resolution) {
   meccano::InsertionOptions options;
   options.resolution = resolution;
-  return meccano::insert_surfaces(meccano::make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, level), std::vector{surface}, options);
+  return meccano::insert_surfaces(meccano::make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, level), std::vector{surface},
+                                  options);
 }
 
 meccano::TriangleSurface spherical_cap() {
@@ -264,7 +268,7 @@ TEST_F(AdapterTest, FilesHoldTheModulesMesh) {
 // between two neighbours, the negative cell behind the normal, the positive one in front, with the
 // triangle's unit normal, which points up as S's does. Returns the listed faces' normals by triangle.
 std::map<std::vector<Corner>, dealii::Tensor<1, 3>> expect_triangulation_of(const meccano::DealiiMesh& mesh,
-                                                                          const meccano::DealiiInterface& interface) {
+                                                                            const meccano::DealiiInterface& interface) {
   dealii::Triangulation<3> triangulation;
   meccano::create_triangulation(mesh, triangulation);
   EXPECT_EQ(triangulation.n_active_cells(), mesh.cells.size());
@@ -404,7 +408,8 @@ void expect_input_error(const std::function<void()>& read, const std::vector<std
     read();
     ADD_FAILURE() << "no error";
   } catch (const meccano::InputError& error) {
-    for (const std::string& part : parts) EXPECT_NE(std::string(error.what()).find(part), std::string::npos) << error.what();
+    for (const std::string& part : parts)
+      EXPECT_NE(std::string(error.what()).find(part), std::string::npos) << error.what();
   }
 }
 
@@ -431,7 +436,8 @@ TEST_F(AdapterTest, BadFilesAreRefusedWithTheirDefect) {
   const std::string none = changed_file(result, "none.msh", [](meccano::MeshGroups& groups) {
     std::erase_if(groups.surfaces, [](const auto& g) { return g.name.rfind("interface_", 0) == 0; });
   });
-  expect_input_error([&] { meccano::read_dealii_mesh(none); }, {"none.msh", "no 2D physical group named interface_NAME"});
+  expect_input_error([&] { meccano::read_dealii_mesh(none); },
+                     {"none.msh", "no 2D physical group named interface_NAME"});
 
   // A box side as an interface: its triangles are on the boundary.
   const std::string floor = changed_file(result, "floor.msh", [](meccano::MeshGroups& groups) {
@@ -451,7 +457,8 @@ TEST_F(AdapterTest, BadFilesAreRefusedWithTheirDefect) {
 
   // Two interfaces: the name must be given.
   const meccano::DealiiMesh mesh = meccano::read_dealii_mesh(changed_file(result, "two.msh", copy_interface_patch));
-  expect_input_error([&] { mesh.interface(); }, {"two.msh: 2 interfaces", "interface_patch, interface_copy", "name the one"});
+  expect_input_error([&] { mesh.interface(); },
+                     {"two.msh: 2 interfaces", "interface_patch, interface_copy", "name the one"});
   expect_input_error([&] { mesh.interface("fault"); }, {"no interface_fault", "interface_patch, interface_copy"});
   EXPECT_EQ(mesh.interface("copy").tag, 8);
   EXPECT_EQ(oriented_triangles(mesh.interface("patch")), oriented_triangles(meccano::dealii_mesh(result).interface()));
@@ -476,7 +483,9 @@ double value_after(const std::string& output, const std::string& label) {
 }
 
 // The value of the first member `key` in a JSON text.
-double json_number(const std::string& json, const std::string& key) { return number_after_pattern(json, "\"" + key + "\": "); }
+double json_number(const std::string& json, const std::string& key) {
+  return number_after_pattern(json, "\"" + key + "\": ");
+}
 
 std::vector<std::vector<double>> read_csv(const std::string& file, std::string& header) {
   std::ifstream in(file);
@@ -495,7 +504,8 @@ using Programs = DemoFiles;
 // Two small levels of the study: errors below bounds set from the measured values with some room,
 // and shrinking by about the optimal factors for P1 (h halves: L2 by 4, H1 by 2).
 TEST_F(Programs, StudyErrorsShrinkWithH) {
-  const Execution study = run_command(std::string(SOLVER_DEMO_STUDY) + " --levels 2 --degree 1 --csv " + path("study.csv"));
+  const Execution study =
+      run_command(std::string(SOLVER_DEMO_STUDY) + " --levels 2 --degree 1 --csv " + path("study.csv"));
   ASSERT_EQ(study.status, 0) << study.output;
   std::string header;
   const auto rows = read_csv(path("study.csv"), header);
@@ -522,8 +532,8 @@ TEST_F(Programs, FluxBalancesOnTheSphericalCap) {
   const double area = interface_area(meccano::dealii_mesh(result).interface());
   std::vector<double> balance;
   for (const char* degree : {"1", "2"}) {
-    const Execution solve = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + path("cap.msh") + " --degree " + degree +
-                          " --vtu " + path("cap"));
+    const Execution solve = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + path("cap.msh") + " --degree " +
+                                        degree + " --vtu " + path("cap"));
     ASSERT_EQ(solve.status, 0) << solve.output;
     EXPECT_NE(solve.output.find("not the cube example's"), std::string::npos) << solve.output;
     EXPECT_EQ(solve.output.find("L2 error"), std::string::npos);
@@ -565,7 +575,8 @@ TEST_F(Programs, EveryBoundaryFaceIsDirichlet) {
   const meccano::InsertionResult result = insert(triangulate_cube_example(24), 9, 0.1);
   meccano::write_msh41(result.mesh, meccano::output_groups(result), path("sides.msh"));
   const std::string fewer = changed_file(result, "fewer.msh", [](meccano::MeshGroups& groups) {
-    std::erase_if(groups.surfaces, [](const auto& g) { return g.name == "xmin" || g.name == "ymax" || g.name == "zmin"; });
+    std::erase_if(groups.surfaces,
+                  [](const auto& g) { return g.name == "xmin" || g.name == "ymax" || g.name == "zmin"; });
   });
   const Execution sides = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + path("sides.msh"));
   const Execution ids_0 = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + fewer);
@@ -586,8 +597,8 @@ TEST_F(Programs, ReportHoldsThePrintedNumbers) {
   ASSERT_EQ(solve.status, 0) << solve.output;
   std::ifstream file(path("run.json"));
   const std::string report((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  for (const char* part : {"\"manufactured\": true", "\"interface\": \"interface_patch\"", "\"degree\": 1", "\"ranks\": 1",
-                           "\"errors\"", "\"flux\"", "\"seconds\""})
+  for (const char* part : {"\"manufactured\": true", "\"interface\": \"interface_patch\"", "\"degree\": 1",
+                           "\"ranks\": 1", "\"errors\"", "\"flux\"", "\"seconds\""})
     ASSERT_NE(report.find(part), std::string::npos) << part << " missing from\n" << report;
   std::smatch dofs;
   ASSERT_TRUE(std::regex_search(solve.output, dofs, std::regex("P1, ([0-9]+) dofs"))) << solve.output;
@@ -595,8 +606,9 @@ TEST_F(Programs, ReportHoldsThePrintedNumbers) {
   EXPECT_EQ(json_number(report, "cells"), static_cast<double>(result.mesh.num_tets()));
   const std::string errors = report.substr(report.find("\"errors\""));
   const std::string flux = report.substr(report.find("\"flux\""));
-  for (const auto& [json, key, label] : {std::tuple{errors, "l2", "L2 error"}, std::tuple{errors, "h1", "H1 error"},
-                                         std::tuple{flux, "source", "source"}, std::tuple{flux, "outflow", "outflow"}}) {
+  for (const auto& [json, key, label] :
+       {std::tuple{errors, "l2", "L2 error"}, std::tuple{errors, "h1", "H1 error"},
+        std::tuple{flux, "source", "source"}, std::tuple{flux, "outflow", "outflow"}}) {
     const double printed = value_after(solve.output, label);
     EXPECT_NEAR(json_number(json, key), printed, 1e-11 * std::abs(printed)) << key;
   }
@@ -611,7 +623,8 @@ TEST_F(Programs, BadInputAndUsage) {
   const std::string poisson = SOLVER_DEMO_POISSON;
   const Execution missing_group = run_command(poisson + " --mesh " + path("patch.msh") + " --interface fault");
   EXPECT_EQ(missing_group.status, 1);
-  EXPECT_NE(missing_group.output.find(path("patch.msh") + ": no interface_fault"), std::string::npos) << missing_group.output;
+  EXPECT_NE(missing_group.output.find(path("patch.msh") + ": no interface_fault"), std::string::npos)
+      << missing_group.output;
   const Execution unnamed = run_command(poisson + " --mesh " + changed_file(result, "two.msh", copy_interface_patch));
   EXPECT_EQ(unnamed.status, 1);
   EXPECT_NE(unnamed.output.find(path("two.msh") + ": 2 interfaces"), std::string::npos) << unnamed.output;
@@ -620,7 +633,8 @@ TEST_F(Programs, BadInputAndUsage) {
   EXPECT_EQ(run_command(poisson).status, 2);
   EXPECT_EQ(run_command(std::string(SOLVER_DEMO_STUDY) + " --levels 0 --degree 1 --csv x.csv").status, 2);
   EXPECT_EQ(run_command(poisson + " --help").status, 0);
-  const Execution unwritable = run_command(std::string(SOLVER_DEMO_STUDY) + " --levels 1 --degree 1 --csv " + path("none/x.csv"));
+  const Execution unwritable =
+      run_command(std::string(SOLVER_DEMO_STUDY) + " --levels 1 --degree 1 --csv " + path("none/x.csv"));
   EXPECT_EQ(unwritable.status, 1);
   EXPECT_NE(unwritable.output.find("none/x.csv"), std::string::npos) << unwritable.output;
 }

@@ -35,11 +35,11 @@
 // | write failing midway (several outputs) | "cannot write PATH: File too large"                  | CliTest.AFailedWriteRemovesTheFilesTheRunWrote        |
 // | full disk (no partial file left)       | "cannot write PATH: File too large"                  | BadInput.AFullDiskLeavesNoPartialFile                 |
 
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
 #include <meccano/io/mesh_writers.hpp>
-#include <meccano/stages/pipeline.hpp>
 #include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/stages/pipeline.hpp>
 
 #include <scratch_directory.hpp>
 #include <test_surfaces.hpp>
@@ -129,7 +129,8 @@ TEST_F(BadInput, TheLimitIsOverridable) {
 // The estimate is within 30 % of the count after healing (SUS adds no tets), on the cube example at
 // resolutions of the three level types, in the unit cube and in a box of unequal cells.
 TEST_F(BadInput, TheEstimateIsWithinThirtyPercentOfTheCount) {
-  const TriangleSurface cube_example = read_surface((fs::path(MECCANO_TEST_DATA_DIR).parent_path().parent_path() / "meshes/cube_example.obj").string());
+  const TriangleSurface cube_example =
+      read_surface((fs::path(MECCANO_TEST_DATA_DIR).parent_path().parent_path() / "meshes/cube_example.obj").string());
   for (const Box& box : {Box{{0, 0, 0}, {1, 1, 1}}, Box{{-0.1, 0, 0.05}, {1.3, 1.05, 0.95}}})
     for (const double resolution : {0.06, 0.05, 0.04}) {
       SCOPED_TRACE("box " + std::to_string(box.max.x()) + ", l_r " + std::to_string(resolution));
@@ -138,8 +139,8 @@ TEST_F(BadInput, TheEstimateIsWithinThirtyPercentOfTheCount) {
       options.last_stage = Stage::approximation;
       const TetMesh meccano = make_cube_meccano(box, 0);
       const InsertionResult result = insert_surfaces(meccano, {&cube_example, 1}, options);
-      const double estimate = static_cast<double>(
-          estimate_tets(meccano.meccano, meccano.num_tets(), {&cube_example, 1}, resolution));
+      const double estimate =
+          static_cast<double>(estimate_tets(meccano.meccano, meccano.num_tets(), {&cube_example, 1}, resolution));
       EXPECT_EQ(result.estimated_tets, static_cast<std::int64_t>(estimate));
       EXPECT_NEAR(estimate / result.mesh.num_tets(), 1.0, 0.3) << estimate << " for " << result.mesh.num_tets();
     }
@@ -157,7 +158,8 @@ TEST_F(BadInput, TheCommandLineRefusesAbsurdSizesAndHonoursMaxTets) {
   const std::string cli = std::string(MECCANO_CLI) + " --box 0,0,0,1,1,1 --quiet ";
   const std::string out = (dir_ / "out.msh").string();
   std::string output;
-  EXPECT_EQ(shell(cli + "--surface " + (dir_ / "patch.obj").string() + " --resolution 1e-6 --output " + out, output), 1);
+  EXPECT_EQ(shell(cli + "--surface " + (dir_ / "patch.obj").string() + " --resolution 1e-6 --output " + out, output),
+            1);
   EXPECT_NE(output.find("the resolution l_r = 1e-06 would make about"), std::string::npos) << output;
   EXPECT_EQ(shell(cli + "--level 40 --output " + out, output), 1);
   EXPECT_NE(output.find("the meccano mesh (--cells, --level) would make about"), std::string::npos) << output;

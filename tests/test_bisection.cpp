@@ -1,14 +1,14 @@
 // Kossaczky bisection on the cube meccano: conformity, exact volume, orientation, similarity classes,
 // local refinement cost, edge splitting and face-tag inheritance.
 
+#include <meccano/error.hpp>
 #include <meccano/mesh/bisection.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
-#include <meccano/error.hpp>
 #include <meccano/mesh/invariants.hpp>
 #include <meccano/mesh/quality.hpp>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
@@ -21,8 +21,8 @@ namespace {
 
 const std::vector<Box> test_boxes{
     {{0, 0, 0}, {1, 1, 1}},
-    {{-1, 2, 0.5}, {1, 3, 1.5}},     // 2 x 1 x 1 cells
-    {{0, 0, 0}, {1, 1.3, 0.6}},      // 2 x 2 x 1 cells of unequal shape
+    {{-1, 2, 0.5}, {1, 3, 1.5}},  // 2 x 1 x 1 cells
+    {{0, 0, 0}, {1, 1.3, 0.6}},   // 2 x 2 x 1 cells of unequal shape
     {{0, 0, 0}, {3, 2, 1}},
 };
 
@@ -97,7 +97,8 @@ TEST(CubeMeccano, CellsAreAsCloseToCubesAsPossible) {
     cells_for_box({{0, 0, 0}, {2000, 1, 1}});
     ADD_FAILURE() << "no error for a 2000:1 box";
   } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("longer along x than its shortest side"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("longer along x than its shortest side"), std::string::npos)
+        << error.what();
   }
   EXPECT_THROW(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, {0, 1, 1}), InputError);
   EXPECT_THROW(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, -1), InputError);
@@ -274,9 +275,9 @@ TEST(Bisection, FaceTagsAreInheritedBySubFaces) {
       ASSERT_EQ(on_plane(t, f), mesh.face_tags[t][f] == interface_tag(0)) << "tet " << t << " face " << f;
       if (on_plane(t, f)) {
         const auto face = mesh.outward_face(t, f);
-        tagged_area += 0.5 * (mesh.points[face[1]] - mesh.points[face[0]])
-                                 .cross(mesh.points[face[2]] - mesh.points[face[0]])
-                                 .norm();
+        tagged_area +=
+            0.5 *
+            (mesh.points[face[1]] - mesh.points[face[0]]).cross(mesh.points[face[2]] - mesh.points[face[0]]).norm();
       }
     }
   EXPECT_NEAR(tagged_area, 2.0, 1e-12);  // both sides of the unit square

@@ -3,9 +3,9 @@
 // MSH 2.2/4.1, ASCII/binary) pass, and corrupted meshes fail with the right reason; the reader's errors
 // name the file, the place and the defect; the command's exit statuses and report.
 
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
 #include <meccano/inspect/mesh_file_check.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/stages/pipeline.hpp>
 
 #include <run_command.hpp>
@@ -56,7 +56,8 @@ std::string first_tet_line(const std::string& msh22) {
 
 // The text with the line `old_line` (the first occurrence) given its last two fields swapped or its last
 // field replaced.
-std::string with_line_edited(std::string text, const std::string& old_line, bool swap_last_two, const std::string& last = {}) {
+std::string with_line_edited(std::string text, const std::string& old_line, bool swap_last_two,
+                             const std::string& last = {}) {
   std::istringstream in(old_line);
   std::vector<std::string> fields{std::istream_iterator<std::string>(in), std::istream_iterator<std::string>()};
   if (swap_last_two) std::swap(fields[fields.size() - 1], fields[fields.size() - 2]);
@@ -86,7 +87,8 @@ class Check : public ::testing::Test {
       InsertionOptions options;
       options.resolution = 0.1;
       options.last_stage = stage;
-      const InsertionResult result = insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {&patch, 1}, options);
+      const InsertionResult result =
+          insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {&patch, 1}, options);
       const std::string prefix = stage == Stage::smoothing ? "final" : "volumetric";
       const MeshGroups groups = output_groups(result, stage);
       write_msh41(result.mesh, groups, (dir_ / (prefix + "41.msh")).string());
@@ -165,7 +167,8 @@ TEST_F(Check, AFlippedTetFailsOrientationAndVolumeNamingIt) {
   std::swap(mesh.tets[5][0], mesh.tets[5][1]);
   const MeshFileCheck check = check_msh_mesh(mesh);
   EXPECT_FALSE(check.passed());
-  EXPECT_TRUE(mentions(check.find("orientation"), "tet " + std::to_string(mesh.tet_tags[5]) + " is negatively oriented"))
+  EXPECT_TRUE(
+      mentions(check.find("orientation"), "tet " + std::to_string(mesh.tet_tags[5]) + " is negatively oriented"))
       << check.text();
   EXPECT_FALSE(check.find("volume")->passed);
   EXPECT_TRUE(check.find("conformity")->passed) << "the same tet in the other vertex order: faces still match";
@@ -246,9 +249,10 @@ TEST_F(Check, InterfaceDefectsAreNamed) {
     std::set<int> used;
     for (const int e : interface.elements) used.insert(two.triangles[e].begin(), two.triangles[e].end());
     const auto far = std::ranges::find_if(two.tets, [&](const std::array<int, 4>& t) {
-      return std::ranges::none_of(t, [&](int v) { return used.count(v) > 0 || two.points[v].z() > 0.99 || two.points[v].z() < 0.01 ||
-                                                         two.points[v].x() < 0.01 || two.points[v].x() > 0.99 ||
-                                                         two.points[v].y() < 0.01 || two.points[v].y() > 0.99; });
+      return std::ranges::none_of(t, [&](int v) {
+        return used.count(v) > 0 || two.points[v].z() > 0.99 || two.points[v].z() < 0.01 || two.points[v].x() < 0.01 ||
+               two.points[v].x() > 0.99 || two.points[v].y() < 0.01 || two.points[v].y() > 0.99;
+      });
     });
     ASSERT_NE(far, two.tets.end());
     two.triangles.push_back({(*far)[1], (*far)[2], (*far)[3]});
@@ -315,7 +319,8 @@ TEST_F(Check, ReaderErrorsNameTheFileThePlaceAndTheDefect) {
       {"nan.msh", good.substr(0, nodes_at) + "1\n1 nan 0 0\n$EndNodes\n", "node 1 has a non-finite coordinate"},
       {"undefined.msh", with_line_edited(good, tet_line, false, "99999999"), "node 99999999 is not defined in $Nodes"},
       {"truncated.msh", good.substr(0, good.size() / 2), "unexpected end of file"},
-      {"no_tets.msh", good.substr(0, good.find(elements_at)) + "$Elements\n0\n$EndElements\n", "no tets (element type 4)"},
+      {"no_tets.msh", good.substr(0, good.find(elements_at)) + "$Elements\n0\n$EndElements\n",
+       "no tets (element type 4)"},
       {"bad_end.msh", with_line_edited(good, "$EndPhysicalNames", false, "$EndPhysical"),
        "expected '$EndPhysicalNames', found '$EndPhysical'"},
   };
@@ -331,8 +336,8 @@ TEST_F(Check, ReaderErrorsNameTheFileThePlaceAndTheDefect) {
     }
   }
   // Binary data: a truncated file names the byte offset.
-  const CommandRun gmsh = run_command("gmsh " + path("box.geo").string() + " -3 -v 1 -format msh41 -bin -o " +
-                                      path("binary.msh").string());
+  const CommandRun gmsh =
+      run_command("gmsh " + path("box.geo").string() + " -3 -v 1 -format msh41 -bin -o " + path("binary.msh").string());
   if (gmsh.status == 0) {
     const std::string binary = file_text(path("binary.msh"));
     write_text(path("binary_truncated.msh"), binary.substr(0, binary.size() * 2 / 3));
@@ -352,8 +357,8 @@ TEST_F(Check, ReaderErrorsNameTheFileThePlaceAndTheDefect) {
 
 TEST_F(Check, TheCommandExitsZeroOnAPassingMeshOneOnAFailingOrUnreadableOneTwoOnMisuse) {
   const std::string cli = MECCANO_CLI;
-  const CommandRun passing = run_command(cli + " check " + path("final41.msh").string() + " --report " +
-                                         path("report.json").string());
+  const CommandRun passing =
+      run_command(cli + " check " + path("final41.msh").string() + " --report " + path("report.json").string());
   EXPECT_EQ(passing.status, 0) << passing.output;
   for (const char* line : {"conformity: ok", "orientation: ok", "volume: ok", "box sides: ok", "interface_patch: ok"})
     EXPECT_NE(passing.output.find(line), std::string::npos) << line << "\n" << passing.output;

@@ -32,7 +32,9 @@ namespace fs = std::filesystem;
 
 using CliRun = testing::CommandRun;
 
-CliRun run_cli(const std::string& arguments) { return testing::run_command(std::string(MECCANO_CLI) + " " + arguments); }
+CliRun run_cli(const std::string& arguments) {
+  return testing::run_command(std::string(MECCANO_CLI) + " " + arguments);
+}
 
 class CliTest : public testing::ScratchDirectoryTest {
  protected:
@@ -101,9 +103,9 @@ TEST_F(CliTest, HelpExitsZeroWithExamples) {
   EXPECT_EQ(run.status, 0);
   EXPECT_NE(run.output.find("--box X0,Y0,Z0,X1,Y1,Z1"), std::string::npos);
   EXPECT_NE(run.output.find("Examples:"), std::string::npos);
-  for (const char* text : {"--msh-version V", ".vtu", ".mesh", "--output fault.vtu", ".ts GOCAD TSurf", "ZPOSITIVE",
-                           "--weld-tolerance D", "--split-parts", "the tets far from the surfaces", "1.26·h·2^(-K/3)",
-                           "A solver's accuracy away from"})
+  for (const char* text :
+       {"--msh-version V", ".vtu", ".mesh", "--output fault.vtu", ".ts GOCAD TSurf", "ZPOSITIVE", "--weld-tolerance D",
+        "--split-parts", "the tets far from the surfaces", "1.26·h·2^(-K/3)", "A solver's accuracy away from"})
     EXPECT_NE(run.output.find(text), std::string::npos) << text;
 }
 
@@ -126,7 +128,8 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
       {"--box 0,0,0,1,1,1 --msh-version 3 --output " + path("a.msh"), "the versions are 4.1 and 2.2"},
       {"--box 0,0,0,1,1,1 --output " + path("a.msh") + " --msh-version 2.2 --output " + path("a.vtu"),
        "--msh-version applies to the .msh outputs after it, and none follows"},
-      {"--box 0,0,0,1,1,1 --surface s.obj --stage volumetric --output " + path("a.msh"), "--surface needs --resolution"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --stage volumetric --output " + path("a.msh"),
+       "--surface needs --resolution"},
       {"--box 0,0,0,1,1,1 --resolution 0.1 --output " + path("a.msh"), "need at least one --surface"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0 --stage volumetric --output " + path("a.msh"),
        "--resolution must be positive"},
@@ -177,8 +180,8 @@ TEST_F(CliTest, WritesTheMeccanoMeshWithBoxGroups) {
 
 TEST_F(CliTest, ProgressReportsEachStageWithCounts) {
   const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
-  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + surface + ":patch --resolution 0.1 --stage volumetric --output " +
-                          path("vm.msh"));
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + surface +
+                             ":patch --resolution 0.1 --stage volumetric --output " + path("vm.msh"));
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_NE(run.output.find("surface patch:"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("volumetric patch:"), std::string::npos) << run.output;
@@ -189,7 +192,8 @@ TEST_F(CliTest, ProgressReportsEachStageWithCounts) {
 // silences these lines with the others.
 TEST_F(CliTest, EverySmoothingSweepHasAProgressLine) {
   const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
-  const std::string arguments = "--box 0,0,0,1,1,1 --surface " + surface + " --resolution 0.1 --output " + path("mesh.msh");
+  const std::string arguments =
+      "--box 0,0,0,1,1,1 --surface " + surface + " --resolution 0.1 --output " + path("mesh.msh");
   const CliRun run = run_cli(arguments);
   ASSERT_EQ(run.status, 0) << run.output;
   // The stage's line counts the sweeps: "smoothing: ... inverted tets before, M after N sweeps (...".
@@ -212,7 +216,7 @@ TEST_F(CliTest, EverySmoothingSweepHasAProgressLine) {
 TEST_F(CliTest, VolumetricStageWritesOneGroupPerSurface) {
   const auto [lower, upper] = write_stacked_pair();
   const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + lower + " --surface " + upper +
-                          ":top --resolution 0.08 --stage volumetric --quiet --output " + path("vm.msh"));
+                             ":top --resolution 0.08 --stage volumetric --quiet --output " + path("vm.msh"));
   ASSERT_EQ(run.status, 0) << run.output;
   const auto sizes = group_sizes(path("vm.msh"));
   ASSERT_TRUE(sizes.count("volumetric_1")) << "the first surface is named by its position";
@@ -291,7 +295,8 @@ TEST_F(CliTest, FullPipelineWritesAnUntangledMeshAReportAndHistograms) {
   std::vector<double> coords, parametric;
   gmsh::model::mesh::getNodes(node_tags, coords, parametric);
   std::map<std::size_t, Eigen::Vector3d> nodes;
-  for (std::size_t i = 0; i < node_tags.size(); ++i) nodes[node_tags[i]] = {coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]};
+  for (std::size_t i = 0; i < node_tags.size(); ++i)
+    nodes[node_tags[i]] = {coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]};
   std::vector<std::size_t> element_tags, tets;
   gmsh::model::mesh::getElementsByType(4, element_tags, tets);
   gmsh::finalize();
@@ -307,11 +312,30 @@ TEST_F(CliTest, FullPipelineWritesAnUntangledMeshAReportAndHistograms) {
 
   std::ifstream report_file(path("report.json"));
   const std::string report((std::istreambuf_iterator<char>(report_file)), std::istreambuf_iterator<char>());
-  for (const char* key : {"\"tets\"", "\"nodes\"", "\"inverted\": 0", "\"before_smoothing\"", "\"after_smoothing\"",
-                          "\"meccano\"", "\"equilateral\"", "\"min\"", "\"mean\"", "\"std\"", "\"min_dihedral_deg\"",
-                          "\"seconds\"", "\"smoothing\"", "\"total\"", "\"improvement\"", "\"tets_below_threshold_before\"",
-                          "\"min_equilateral_quality_after\"", "\"operations\"", "\"flips_2_3\"", "\"flips_3_2\"",
-                          "\"flips_4_4\"", "\"edge_removals\"", "\"surface_edge_flips\"", "\"remeshed_tets\""})
+  for (const char* key : {"\"tets\"",
+                          "\"nodes\"",
+                          "\"inverted\": 0",
+                          "\"before_smoothing\"",
+                          "\"after_smoothing\"",
+                          "\"meccano\"",
+                          "\"equilateral\"",
+                          "\"min\"",
+                          "\"mean\"",
+                          "\"std\"",
+                          "\"min_dihedral_deg\"",
+                          "\"seconds\"",
+                          "\"smoothing\"",
+                          "\"total\"",
+                          "\"improvement\"",
+                          "\"tets_below_threshold_before\"",
+                          "\"min_equilateral_quality_after\"",
+                          "\"operations\"",
+                          "\"flips_2_3\"",
+                          "\"flips_3_2\"",
+                          "\"flips_4_4\"",
+                          "\"edge_removals\"",
+                          "\"surface_edge_flips\"",
+                          "\"remeshed_tets\""})
     EXPECT_NE(report.find(key), std::string::npos) << key << " missing from\n" << report;
   std::ifstream histogram_file(path("q.csv"));
   std::string header;
@@ -374,8 +398,8 @@ TEST_F(CliTest, BadSurfacesFailWithTheirOwnMessageAndWriteNothing) {
   };
   for (const auto& [name, surface_and_message] : cases) {
     const std::string file = write_obj(name, surface_and_message.first);
-    const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + file + " --resolution 0.1 --stage volumetric --output " +
-                            path("out.msh"));
+    const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + file +
+                               " --resolution 0.1 --stage volumetric --output " + path("out.msh"));
     EXPECT_EQ(run.status, 1) << name << "\n" << run.output;
     EXPECT_NE(run.output.find(name), std::string::npos) << "the message names the file\n" << run.output;
     EXPECT_NE(run.output.find(surface_and_message.second), std::string::npos) << run.output;
@@ -384,13 +408,17 @@ TEST_F(CliTest, BadSurfacesFailWithTheirOwnMessageAndWriteNothing) {
   // The tilted plane crosses the patch.
   const std::string file = write_obj("patch.obj", patch);
   const std::string crossing = write_obj("plane.obj", testing::tilted_plane(6));
-  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + file + " --surface " + crossing + " --resolution 0.1 "
-                          "--stage volumetric --output " + path("out.msh"));
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + file + " --surface " + crossing +
+                             " --resolution 0.1 "
+                             "--stage volumetric --output " +
+                             path("out.msh"));
   EXPECT_EQ(run.status, 1) << run.output;
   EXPECT_NE(run.output.find("intersect"), std::string::npos) << run.output;
   EXPECT_FALSE(fs::exists(path("out.msh")));
-  const CliRun missing = run_cli("--box 0,0,0,1,1,1 --surface " + path("none.obj") + " --resolution 0.1 --stage volumetric "
-                              "--output " + path("out.msh"));
+  const CliRun missing = run_cli("--box 0,0,0,1,1,1 --surface " + path("none.obj") +
+                                 " --resolution 0.1 --stage volumetric "
+                                 "--output " +
+                                 path("out.msh"));
   EXPECT_EQ(missing.status, 1);
   EXPECT_NE(missing.output.find("none.obj"), std::string::npos) << missing.output;
   EXPECT_TRUE(only_inputs_in_directory(5));
@@ -499,10 +527,10 @@ std::map<int, std::size_t> medit_triangles_per_reference(const std::string& file
 // Every format from one run of the whole method: the same groups with the same counts in each.
 TEST_F(CliTest, WritesEveryFormatInOneRunWithBothInterfaces) {
   const auto [lower, upper] = write_stacked_pair();
-  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + lower + ":bottom --surface " + upper +
-                             ":top --resolution 0.1 --quiet --output " + path("new.msh") + " --msh-version 2.2" +
-                             " --output " + path("old.msh") + " --output " + path("mesh.vtu") + " --output " +
-                             path("mesh.mesh"));
+  const CliRun run =
+      run_cli("--box 0,0,0,1,1,1 --surface " + lower + ":bottom --surface " + upper +
+              ":top --resolution 0.1 --quiet --output " + path("new.msh") + " --msh-version 2.2" + " --output " +
+              path("old.msh") + " --output " + path("mesh.vtu") + " --output " + path("mesh.mesh"));
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_EQ(file_text(path("new.msh")).rfind("$MeshFormat\n4.1 0 8\n", 0), 0u);
   EXPECT_EQ(file_text(path("old.msh")).rfind("$MeshFormat\n2.2 0 8\n", 0), 0u);

@@ -4,14 +4,14 @@
 // surface, and the mesh is the same on 1 and 2 threads. The crease mends on a real fault. About a minute:
 // label `long`.
 
+#include <meccano/geometry/geometry.hpp>
+#include <meccano/inspect/mesh_file_measure.hpp>
 #include <meccano/io/surface_readers.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
-#include <meccano/geometry/geometry.hpp>
-#include <meccano/stages/improvement.hpp>
 #include <meccano/mesh/invariants.hpp>
-#include <meccano/inspect/mesh_file_measure.hpp>
-#include <meccano/stages/pipeline.hpp>
 #include <meccano/mesh/quality.hpp>
+#include <meccano/stages/improvement.hpp>
+#include <meccano/stages/pipeline.hpp>
 
 #include <test_surfaces.hpp>
 
@@ -28,7 +28,8 @@ namespace {
 
 // The interface of surface s after flips or crease mends: every face's normal on the side of S's, S_M's
 // triangle list the tagged faces, every S_M node on S, and no tet with its four vertices on S_M.
-void expect_interface_on_surface(const InsertionResult& result, std::span<const TriangleSurface> surfaces, const Box& box) {
+void expect_interface_on_surface(const InsertionResult& result, std::span<const TriangleSurface> surfaces,
+                                 const Box& box) {
   const std::vector<SurfaceInterface> interfaces = surface_interfaces(result);
   ASSERT_EQ(interfaces.size(), surfaces.size());
   for (std::size_t s = 0; s < surfaces.size(); ++s) {
@@ -37,7 +38,8 @@ void expect_interface_on_surface(const InsertionResult& result, std::span<const 
     const SurfaceProjection& projection = result.surfaces[s].projection;
     std::set<std::array<VertexId, 3>> listed, tagged;
     for (const auto& triangle : projection.triangles) {
-      std::array<VertexId, 3> key{projection.nodes[triangle[0]], projection.nodes[triangle[1]], projection.nodes[triangle[2]]};
+      std::array<VertexId, 3> key{projection.nodes[triangle[0]], projection.nodes[triangle[1]],
+                                  projection.nodes[triangle[2]]};
       std::sort(key.begin(), key.end());
       listed.insert(key);
     }
@@ -46,7 +48,8 @@ void expect_interface_on_surface(const InsertionResult& result, std::span<const 
       std::sort(key.begin(), key.end());
       tagged.insert(key);
       const Eigen::Vector3d centroid = (result.mesh.points[face.vertices[0]] + result.mesh.points[face.vertices[1]] +
-                                        result.mesh.points[face.vertices[2]]) / 3.0;
+                                        result.mesh.points[face.vertices[2]]) /
+                                       3.0;
       const auto& t = surface.triangles[tree.closest_point(centroid).triangle];
       const Eigen::Vector3d normal_of_s =
           (surface.points[t[1]] - surface.points[t[0]]).cross(surface.points[t[2]] - surface.points[t[0]]);
@@ -81,8 +84,8 @@ TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
     const MeshInvariantReport check = verify_mesh(flipped.mesh, {.physical = true});
     ASSERT_TRUE(check.ok()) << check.summary();
     EXPECT_GE(flipped.quality_after_smoothing.equilateral.min, smoothed.improvement->min_quality_before);
-    EXPECT_EQ(flipped.improvement->remeshed_tets,
-              std::count_if(flipped.mesh.kinds.begin(), flipped.mesh.kinds.end(), [](TetKind k) { return !k.bisectable(); }));
+    EXPECT_EQ(flipped.improvement->remeshed_tets, std::count_if(flipped.mesh.kinds.begin(), flipped.mesh.kinds.end(),
+                                                                [](TetKind k) { return !k.bisectable(); }));
     expect_interface_on_surface(flipped, c.surfaces, c.box);
   }
   EXPECT_GT(surface_edge_flips, 0) << "no case flipped an edge inside S_M: that path went untested";
@@ -141,7 +144,8 @@ TEST(Creases, MendedAfterSmoothingPutSurfaceNodesOnTheLines) {
 // threads.
 TEST(Flips, GiveTheSameMeshWithOneAndTwoThreads) {
   const auto cases = testing::surface_cases(16, true);
-  const auto c = std::find_if(cases.begin(), cases.end(), [](const auto& candidate) { return candidate.name == "spherical_cap_perturbed_lr24"; });
+  const auto c = std::find_if(cases.begin(), cases.end(),
+                              [](const auto& candidate) { return candidate.name == "spherical_cap_perturbed_lr24"; });
   ASSERT_NE(c, cases.end());
   InsertionOptions options;
   options.resolution = c->resolution;

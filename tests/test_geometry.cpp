@@ -114,8 +114,8 @@ Vector3d random_point(std::mt19937_64& generator, double lo, double hi) {
 
 Tetrahedron3 random_tetrahedron(std::mt19937_64& generator) {
   for (;;) {
-    const Tetrahedron3 tet{random_point(generator, 0, 1), random_point(generator, 0, 1),
-                           random_point(generator, 0, 1), random_point(generator, 0, 1)};
+    const Tetrahedron3 tet{random_point(generator, 0, 1), random_point(generator, 0, 1), random_point(generator, 0, 1),
+                           random_point(generator, 0, 1)};
     const double volume = std::abs((tet[1] - tet[0]).cross(tet[2] - tet[0]).dot(tet[3] - tet[0]));
     if (volume > 1e-3) return tet;
   }
@@ -176,15 +176,15 @@ Triangle3 make_triangle(Family family, const Tetrahedron3& tet, double offset, s
     }
     case Family::coplanar_with_face:
       return {on_face_plane(-0.5, 1.5), on_face_plane(-0.5, 1.5), on_face_plane(-0.5, 1.5)};
-    default:
-      return {};
+    default: return {};
   }
 }
 
 // Distance between a triangle and a tetrahedron that do not intersect: the nearest tet point is on a face.
 double distance_to_tetrahedron(const Triangle3& tri, const Tetrahedron3& tet) {
   double best = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < 4; ++i) best = std::min(best, triangle_distance(tri, {tet[(i + 1) % 4], tet[(i + 2) % 4], tet[(i + 3) % 4]}));
+  for (int i = 0; i < 4; ++i)
+    best = std::min(best, triangle_distance(tri, {tet[(i + 1) % 4], tet[(i + 2) % 4], tet[(i + 3) % 4]}));
   return best;
 }
 
@@ -211,7 +211,8 @@ TEST(Geometry, TriangleTetrahedronNeverMissesAnIntersection) {
       const bool expected = reference_intersects(tri, tet);
       const bool actual = triangle_intersects_tetrahedron(tri, tet);
       // Vertex order and orientation of either shape do not matter for a true intersection.
-      const bool reordered = triangle_intersects_tetrahedron({tri[1], tri[2], tri[0]}, {tet[2], tet[0], tet[3], tet[1]});
+      const bool reordered =
+          triangle_intersects_tetrahedron({tri[1], tri[2], tri[0]}, {tet[2], tet[0], tet[3], tet[1]});
       if (expected && !(actual && reordered)) {
         ADD_FAILURE() << "missed intersection, family " << family_name(family) << ", configuration " << k;
       }
@@ -248,21 +249,25 @@ TEST(Geometry, TriangleTetrahedronExactContacts) {
   EXPECT_TRUE(triangle_intersects_tetrahedron({Vector3d(1, 0, 0), Vector3d(2, 1, 0), Vector3d(2, 0, 1)}, tet));
   // The plane x = 1 touches the tet at its vertex (1, 0, 0), inside the triangle.
   EXPECT_TRUE(triangle_intersects_tetrahedron({Vector3d(1, -1, -1), Vector3d(1, 2, -1), Vector3d(1, -1, 2)}, tet));
-  EXPECT_FALSE(
-      triangle_intersects_tetrahedron({Vector3d(1 + 1e-6, -1, -1), Vector3d(1 + 1e-6, 2, -1), Vector3d(1 + 1e-6, -1, 2)}, tet));
+  EXPECT_FALSE(triangle_intersects_tetrahedron(
+      {Vector3d(1 + 1e-6, -1, -1), Vector3d(1 + 1e-6, 2, -1), Vector3d(1 + 1e-6, -1, 2)}, tet));
   // Edge lying on the face z = 0, rest below.
-  EXPECT_TRUE(triangle_intersects_tetrahedron({Vector3d(0.25, 0.25, 0), Vector3d(0.5, 0.25, 0), Vector3d(0.25, 0.5, -1)}, tet));
-  // Edge crossing the tet edge (1,0,0)-(0,1,0) at (0.5, 0.5, 0), triangle otherwise outside.
   EXPECT_TRUE(
-      triangle_intersects_tetrahedron({Vector3d(0.75, 0.75, 0.5), Vector3d(0.25, 0.25, -0.5), Vector3d(1.5, 1.5, 0)}, tet));
+      triangle_intersects_tetrahedron({Vector3d(0.25, 0.25, 0), Vector3d(0.5, 0.25, 0), Vector3d(0.25, 0.5, -1)}, tet));
+  // Edge crossing the tet edge (1,0,0)-(0,1,0) at (0.5, 0.5, 0), triangle otherwise outside.
+  EXPECT_TRUE(triangle_intersects_tetrahedron(
+      {Vector3d(0.75, 0.75, 0.5), Vector3d(0.25, 0.25, -0.5), Vector3d(1.5, 1.5, 0)}, tet));
   // Moved by 1e-6 along the separating direction (1, 1, -1) (the cross product of the two edges).
   const Vector3d shift = 1e-6 * Vector3d(1, 1, -1);
   EXPECT_FALSE(triangle_intersects_tetrahedron(
       {Vector3d(0.75, 0.75, 0.5) + shift, Vector3d(0.25, 0.25, -0.5) + shift, Vector3d(1.5, 1.5, 0) + shift}, tet));
   // Coplanar with the face z = 0 and overlapping it; a triangle inside the tet; one containing it.
-  EXPECT_TRUE(triangle_intersects_tetrahedron({Vector3d(0.5, 0.5, 0), Vector3d(-1, 0.2, 0), Vector3d(0.2, -1, 0)}, tet));
-  EXPECT_TRUE(triangle_intersects_tetrahedron({Vector3d(0.1, 0.1, 0.1), Vector3d(0.2, 0.1, 0.1), Vector3d(0.1, 0.2, 0.1)}, tet));
-  EXPECT_TRUE(triangle_intersects_tetrahedron({Vector3d(-5, -5, 0.2), Vector3d(10, -5, 0.2), Vector3d(-5, 10, 0.2)}, tet));
+  EXPECT_TRUE(
+      triangle_intersects_tetrahedron({Vector3d(0.5, 0.5, 0), Vector3d(-1, 0.2, 0), Vector3d(0.2, -1, 0)}, tet));
+  EXPECT_TRUE(triangle_intersects_tetrahedron(
+      {Vector3d(0.1, 0.1, 0.1), Vector3d(0.2, 0.1, 0.1), Vector3d(0.1, 0.2, 0.1)}, tet));
+  EXPECT_TRUE(
+      triangle_intersects_tetrahedron({Vector3d(-5, -5, 0.2), Vector3d(10, -5, 0.2), Vector3d(-5, 10, 0.2)}, tet));
   EXPECT_FALSE(triangle_intersects_tetrahedron({Vector3d(2, 2, 2), Vector3d(3, 2, 2), Vector3d(2, 3, 2)}, tet));
 }
 
@@ -503,9 +508,9 @@ std::vector<SurfacePoint> points_with_normals(const TriangleSurface& s, std::mt1
 
 TEST(Geometry, SideAlongPseudoNormalsAtAllDistances) {
   std::mt19937_64 generator(19);
-  for (const TriangleSurface& surface : {testing::spherical_cap(8), testing::saddle(8),
-                                         testing::perturbed(testing::saddle(8), 0.25, 3),
-                                         testing::strongly_curved_sheet(6)}) {
+  for (const TriangleSurface& surface :
+       {testing::spherical_cap(8), testing::saddle(8), testing::perturbed(testing::saddle(8), 0.25, 3),
+        testing::strongly_curved_sheet(6)}) {
     const TriangleBVH bvh(surface);
     int vertex_features = 0;
     int edge_features = 0;
@@ -570,8 +575,8 @@ TEST(Geometry, SideNearSharpRidgesAndApexes) {
       {testing::graph_patch([](double x, double y) { return 0.8 - 1.5 * std::max(abs(x - 0.5), abs(y - 0.5)); },
                             {0.3, 0.7}, {0.3, 0.7}, 8, "pyramid"),
        Vector3d(0.5, 0.5, 0.8)},
-      {testing::graph_patch([](double x, double y) { return 0.8 - 3.0 * std::hypot(x - 0.5, y - 0.5); },
-                            {0.4, 0.6}, {0.4, 0.6}, 8, "cone"),
+      {testing::graph_patch([](double x, double y) { return 0.8 - 3.0 * std::hypot(x - 0.5, y - 0.5); }, {0.4, 0.6},
+                            {0.4, 0.6}, 8, "cone"),
        Vector3d(0.5, 0.5, 0.8)}};
   std::mt19937_64 generator(31);
   for (const auto& [surface, apex] : cases) {

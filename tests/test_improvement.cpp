@@ -5,14 +5,14 @@
 // stays conforming with its box sides tagged and flipped tets leave the bisection hierarchy
 // (test_flips_pipeline runs them through the pipeline).
 
-#include <meccano/mesh/bisection.hpp>
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
 #include <meccano/geometry/geometry.hpp>
-#include <meccano/stages/improvement.hpp>
+#include <meccano/mesh/bisection.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/mesh/invariants.hpp>
-#include <meccano/stages/pipeline.hpp>
 #include <meccano/mesh/quality.hpp>
+#include <meccano/stages/improvement.hpp>
+#include <meccano/stages/pipeline.hpp>
 
 #include <test_surfaces.hpp>
 
@@ -39,7 +39,8 @@ TetMesh mesh_with_slivers() {
   };
   for (VertexId v = 0; v < mesh.num_vertices(); v += 4) {
     if (!inner(v)) continue;
-    const VertexId neighbour = mesh.tets[stars.of(v)[0]][0] == v ? mesh.tets[stars.of(v)[0]][1] : mesh.tets[stars.of(v)[0]][0];
+    const VertexId neighbour =
+        mesh.tets[stars.of(v)[0]][0] == v ? mesh.tets[stars.of(v)[0]][1] : mesh.tets[stars.of(v)[0]][0];
     const Eigen::Vector3d before = mesh.points[v];
     for (double fraction : {0.97, 0.9, 0.8, 0.6}) {  // the largest move that keeps the mesh valid
       mesh.points[v] = before + fraction * (mesh.points[neighbour] - before);
@@ -170,7 +171,8 @@ TEST(Flips, MendSliversWithoutTouchingTheBoxAndEndTheHierarchyWhereTheyAct) {
   for (TetId t = 0; t < mesh.num_tets(); ++t) remeshed += !mesh.bisectable(t);
   EXPECT_GT(remeshed, 0);
   EXPECT_LE(remeshed, stats.tets_created);
-  const auto first_remeshed = std::find_if(mesh.kinds.begin(), mesh.kinds.end(), [](TetKind k) { return !k.bisectable(); });
+  const auto first_remeshed =
+      std::find_if(mesh.kinds.begin(), mesh.kinds.end(), [](TetKind k) { return !k.bisectable(); });
   const TetId t = static_cast<TetId>(first_remeshed - mesh.kinds.begin());
   EXPECT_EQ(mesh.level(t), -1);
   const std::vector<TetId> marked{t};

@@ -1,9 +1,9 @@
 // The library call a solver uses (stages/pipeline.hpp): insert_surfaces with its options, and
 // surface_interfaces, each surface's faces with the tets on both sides and one consistent normal.
 
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
 #include <meccano/geometry/geometry.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/report/insertion_report.hpp>
 #include <meccano/stages/pipeline.hpp>
 #include <meccano/stages/volumetric_approximation.hpp>
@@ -47,7 +47,8 @@ Vector3d surface_normal_near(const TriangleSurface& surface, const TriangleBVH& 
 
 // Every face: both tets hold it, the normal follows the vertex order and points from `negative` into
 // `positive`, and agrees with S's normal there; each tagged face is listed once.
-void expect_consistent(const InsertionResult& result, const SurfaceInterface& interface, const TriangleSurface& surface) {
+void expect_consistent(const InsertionResult& result, const SurfaceInterface& interface,
+                       const TriangleSurface& surface) {
   const TetMesh& mesh = result.mesh;
   const TriangleBVH tree(surface);
   std::set<std::array<VertexId, 3>> seen;

@@ -16,17 +16,32 @@ namespace {
 TEST(JsonWriter, NestsObjectsAndArraysWithTwoSpaceIndent) {
   JsonWriter json;
   json.begin_object()
-      .key("name").value("cube")
-      .key("tets").value(std::int64_t{6144})
-      .key("threads").value(2)
-      .key("ok").value(true)
-      .key("quality").begin_object()
-          .key("min").value(0.5)
-          .key("bins").begin_array().value(1).value(2).end_array()
+      .key("name")
+      .value("cube")
+      .key("tets")
+      .value(std::int64_t{6144})
+      .key("threads")
+      .value(2)
+      .key("ok")
+      .value(true)
+      .key("quality")
+      .begin_object()
+      .key("min")
+      .value(0.5)
+      .key("bins")
+      .begin_array()
+      .value(1)
+      .value(2)
+      .end_array()
       .end_object()
-      .key("empty_array").begin_array().end_array()
-      .key("empty_object").begin_object().end_object()
-      .key("none").null()
+      .key("empty_array")
+      .begin_array()
+      .end_array()
+      .key("empty_object")
+      .begin_object()
+      .end_object()
+      .key("none")
+      .null()
       .end_object();
   EXPECT_EQ(json.str(), R"({
   "name": "cube",
@@ -78,17 +93,17 @@ TEST(JsonWriter, DoublesReadBackExactlyAndNonFiniteOnesAreNull) {
 }
 
 TEST(JsonWriter, MisuseThrowsLogicError) {
-  EXPECT_THROW(JsonWriter().begin_object().value(1), std::logic_error);          // value without key
-  EXPECT_THROW(JsonWriter().begin_object().key("a").key("b"), std::logic_error);  // key after key
-  EXPECT_THROW(JsonWriter().begin_array().key("a"), std::logic_error);            // key in an array
-  EXPECT_THROW(JsonWriter().key("a"), std::logic_error);                          // key at the root
-  EXPECT_THROW(JsonWriter().begin_object().end_array(), std::logic_error);        // mismatched end
-  EXPECT_THROW(JsonWriter().end_object(), std::logic_error);                      // end without begin
+  EXPECT_THROW(JsonWriter().begin_object().value(1), std::logic_error);               // value without key
+  EXPECT_THROW(JsonWriter().begin_object().key("a").key("b"), std::logic_error);      // key after key
+  EXPECT_THROW(JsonWriter().begin_array().key("a"), std::logic_error);                // key in an array
+  EXPECT_THROW(JsonWriter().key("a"), std::logic_error);                              // key at the root
+  EXPECT_THROW(JsonWriter().begin_object().end_array(), std::logic_error);            // mismatched end
+  EXPECT_THROW(JsonWriter().end_object(), std::logic_error);                          // end without begin
   EXPECT_THROW(JsonWriter().begin_object().key("a").end_object(), std::logic_error);  // key without value
-  EXPECT_THROW(JsonWriter().value(1).value(2), std::logic_error);                 // two roots
+  EXPECT_THROW(JsonWriter().value(1).value(2), std::logic_error);                     // two roots
   EXPECT_THROW(JsonWriter().begin_array().end_array().begin_array(), std::logic_error);
-  EXPECT_THROW(JsonWriter().begin_array().str(), std::logic_error);               // unfinished
-  EXPECT_THROW(JsonWriter().str(), std::logic_error);                             // empty
+  EXPECT_THROW(JsonWriter().begin_array().str(), std::logic_error);  // unfinished
+  EXPECT_THROW(JsonWriter().str(), std::logic_error);                // empty
 }
 
 }  // namespace

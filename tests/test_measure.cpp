@@ -4,10 +4,10 @@
 // larger square; a regular tet beside an inverted one) they give those answers; the command's report is
 // the library's, and its errors name the files.
 
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/io/mesh_writers.hpp>
 #include <meccano/inspect/mesh_file_measure.hpp>
+#include <meccano/io/mesh_writers.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/stages/pipeline.hpp>
 
 #include <run_command.hpp>
@@ -55,7 +55,8 @@ class ModuleMesh : public ::testing::Test {
     InsertionOptions options;
     options.resolution = resolution;
     result_ = new InsertionResult(insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {patch_, 1}, options));
-    file_ = (std::filesystem::temp_directory_path() / ("meccano-measure-" + std::to_string(::getpid()) + ".msh")).string();
+    file_ =
+        (std::filesystem::temp_directory_path() / ("meccano-measure-" + std::to_string(::getpid()) + ".msh")).string();
     write_msh41(result_->mesh, output_groups(*result_), file_);
   }
   static void TearDownTestSuite() {
@@ -126,7 +127,9 @@ class SquarePatch : public testing::ScratchDirectoryTest {
         bool on_square = true, in_hole = hole;
         for (const VertexId v : mesh.outward_face(t, f)) {
           const Eigen::Vector3d& p = mesh.points[v];
-          const auto within = [&p](double lo, double hi) { return p.x() >= lo && p.x() <= hi && p.y() >= lo && p.y() <= hi; };
+          const auto within = [&p](double lo, double hi) {
+            return p.x() >= lo && p.x() <= hi && p.y() >= lo && p.y() <= hi;
+          };
           on_square = on_square && p.z() == 0.5 && within(0.25, 0.75);
           in_hole = in_hole && within(0.375, 0.625);
         }
@@ -237,10 +240,10 @@ TEST_F(SquarePatch, CommandWritesTheLibrarysReport) {
   shifted.source = path("square.obj");
   const std::string report = file_text(path("m.json"));
   EXPECT_EQ(report, measure_mesh_file(mesh, {&shifted, 1}).json());
-  for (const char* key : {"\"file\"", "\"nodes\"", "\"tets\"", "\"inverted\": 0", "\"below_0.1\"", "\"below_0.3\"",
-                          "\"min_dihedral_deg\"", "\"interfaces\"", "\"name\": \"interface_square\"", "\"surface\"",
-                          "\"node_distance\"", "\"hausdorff\"", "\"normal_deviation_deg\"", "\"flipped_faces\": 0",
-                          "\"area_ratio\""})
+  for (const char* key :
+       {"\"file\"", "\"nodes\"", "\"tets\"", "\"inverted\": 0", "\"below_0.1\"", "\"below_0.3\"",
+        "\"min_dihedral_deg\"", "\"interfaces\"", "\"name\": \"interface_square\"", "\"surface\"", "\"node_distance\"",
+        "\"hausdorff\"", "\"normal_deviation_deg\"", "\"flipped_faces\": 0", "\"area_ratio\""})
     EXPECT_NE(report.find(key), std::string::npos) << key << " missing from\n" << report;
   EXPECT_EQ(run_command(measure + " --quiet").output, "");
 }

@@ -3,16 +3,16 @@
 // orientation and qualities must match the mesh written. Also the atomic-write guarantee and the
 // rejection of unknown formats and invalid groups.
 
-#include <meccano/io/atomic_file.hpp>
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
+#include <meccano/io/atomic_file.hpp>
 #include <meccano/io/mesh_writers.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 
 #include <vtu_reader.hpp>
 
 #include <gmsh.h>
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <filesystem>
@@ -133,9 +133,9 @@ TetGroup every_nth_tet(const TetMesh& mesh, const std::string& name, int tag, in
 }
 
 // Outward normal times area of each box side of the 2 x 1 x 1 box.
-const std::map<std::string, Eigen::Vector3d> bar_side_normals{
-    {"xmin", {-1, 0, 0}}, {"xmax", {1, 0, 0}}, {"ymin", {0, -2, 0}},
-    {"ymax", {0, 2, 0}},  {"zmin", {0, 0, -2}}, {"zmax", {0, 0, 2}}};
+const std::map<std::string, Eigen::Vector3d> bar_side_normals{{"xmin", {-1, 0, 0}}, {"xmax", {1, 0, 0}},
+                                                              {"ymin", {0, -2, 0}}, {"ymax", {0, 2, 0}},
+                                                              {"zmin", {0, 0, -2}}, {"zmax", {0, 0, 2}}};
 
 std::size_t boundary_face_count(const TetMesh& mesh) {
   std::size_t count = 0;
@@ -315,7 +315,7 @@ TEST(MeshIo, VtuIsReadBackWithCellsGroupsAndQualities) {
       ASSERT_EQ(types[c], 5) << "cell " << c;
       ASSERT_EQ(size, 3u);
       sum_at(normal_sum, tag) += 0.5 * (point(connectivity[begin + 1]) - point(connectivity[begin]))
-                                   .cross(point(connectivity[begin + 2]) - point(connectivity[begin]));
+                                           .cross(point(connectivity[begin + 2]) - point(connectivity[begin]));
       EXPECT_EQ(meccano_quality[c], 1.0);
       EXPECT_EQ(equilateral_quality[c], 1.0);
     }
@@ -365,11 +365,12 @@ TEST(MeshIo, InvalidGroupsAreRejectedBeforeAnythingIsWritten) {
   zero_tag.volumes[0].tag = 0;
   const fs::path dir = temporary_directory();
   for (const auto& [format, write] : writers)
-    for (const auto& [groups, message] : {std::pair{missing_tet, "mesh group stray: tet 6 does not exist"},
-                                          std::pair{missing_face, "mesh group bad_face: tet 0 has no local face 4"},
-                                          std::pair{quoted, "names may not hold"},
-                                          std::pair{repeated_tag, "interface_again: tag 6 is already the tag of another 2D"},
-                                          std::pair{zero_tag, "mesh group domain: tag 0 is not positive"}}) {
+    for (const auto& [groups, message] :
+         {std::pair{missing_tet, "mesh group stray: tet 6 does not exist"},
+          std::pair{missing_face, "mesh group bad_face: tet 0 has no local face 4"},
+          std::pair{quoted, "names may not hold"},
+          std::pair{repeated_tag, "interface_again: tag 6 is already the tag of another 2D"},
+          std::pair{zero_tag, "mesh group domain: tag 0 is not positive"}}) {
       try {
         write(mesh, groups, (dir / "out").string());
         ADD_FAILURE() << format << ": no error for " << message;
@@ -390,11 +391,12 @@ TEST(MeshIo, FailedWriteLeavesNoFile) {
   const fs::path dir = temporary_directory();
   const fs::path path = dir / "failing.msh";
   // A writer that fails half-way must not leave the target or a temporary behind.
-  EXPECT_THROW(write_file_atomically(path.string(),
-                                     [](std::ostream& out) {
-                                       out << "partial content";
-                                       throw std::runtime_error("simulated failure");
-                                     }),
+  EXPECT_THROW(write_file_atomically(
+                   path.string(),
+                   [](std::ostream& out) {
+    out << "partial content";
+    throw std::runtime_error("simulated failure");
+                   }),
                std::runtime_error);
   EXPECT_TRUE(fs::is_empty(dir));
   fs::remove_all(dir);

@@ -311,8 +311,8 @@ void expect_projection_onto(const TriangleSurface& s, const TriangleSurface& s_m
   for (int v : m.rim) {
     double nearest = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < s_rim.size(); ++i)
-      nearest = std::min(nearest,
-                         segment_distance(image[v], s.points[s_rim[i]], s.points[s_rim[(i + 1) % s_rim.size()]]));
+      nearest =
+          std::min(nearest, segment_distance(image[v], s.points[s_rim[i]], s.points[s_rim[(i + 1) % s_rim.size()]]));
     off_rim = std::max(off_rim, nearest);
   }
   for (int k = 0; k < 4; ++k) EXPECT_LT((image[m_corners[k]] - targets[k]).norm(), tolerance) << "corner " << k;
@@ -433,8 +433,7 @@ bool segment_meets_triangle(const Vector2d& p, const Vector2d& q, const std::arr
     const double t_hi = std::max({axis.dot(tri[0]), axis.dot(tri[1]), axis.dot(tri[2])});
     return std::max(axis.dot(p), axis.dot(q)) <= t_lo || t_hi <= std::min(axis.dot(p), axis.dot(q));
   };
-  return !separated(q - p) && !separated(tri[1] - tri[0]) && !separated(tri[2] - tri[1]) &&
-         !separated(tri[0] - tri[2]);
+  return !separated(q - p) && !separated(tri[1] - tri[0]) && !separated(tri[2] - tri[1]) && !separated(tri[0] - tri[2]);
 }
 
 TEST(ParameterizationLocate, WalkIsStraight) {
@@ -597,7 +596,7 @@ TEST(Parameterization, CornersMustBeRimVerticesInCyclicOrder) {
   const TriangleSurface plane = testing::tilted_plane(4);
   EXPECT_THROW(parameterize_to_square(plane, {0, 6, 24, 20}), std::invalid_argument);  // 6 is interior
   EXPECT_THROW(parameterize_to_square(plane, {0, 24, 4, 20}), std::invalid_argument);  // not cyclic
-  EXPECT_EQ(parameterize_to_square(plane, {0, 20, 24, 4}).orientation, -1);  // cyclic, against the rim
+  EXPECT_EQ(parameterize_to_square(plane, {0, 20, 24, 4}).orientation, -1);            // cyclic, against the rim
 }
 
 }  // namespace

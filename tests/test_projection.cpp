@@ -131,7 +131,8 @@ TEST(Creases, ARoofKeepsItsRidgeThroughSmoothing) {
     int off = 0;
     const std::vector<SurfaceInterface> interfaces = surface_interfaces(result);
     for (const InterfaceFace& face : interfaces[0].faces) {
-      if (std::min(std::acos(std::min(1.0, face.normal.dot(left))), std::acos(std::min(1.0, face.normal.dot(right)))) < 1e-6)
+      if (std::min(std::acos(std::min(1.0, face.normal.dot(left))), std::acos(std::min(1.0, face.normal.dot(right)))) <
+          1e-6)
         continue;
       ++off;
       double from_rim = 1.0;

@@ -2,9 +2,9 @@
 // its counterpart, Kuhn class values against the equilateral tet), inverted tets counted as 0, agreement
 // with a direct serial computation, independence of the thread count, and the histogram CSV.
 
+#include <meccano/error.hpp>
 #include <meccano/mesh/bisection.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
-#include <meccano/error.hpp>
 #include <meccano/mesh/quality.hpp>
 #include <meccano/report/quality_csv.hpp>
 
@@ -152,8 +152,7 @@ TEST(QualitySummary, UntouchedCubeHasMeccanoQualityOneAndKuhnClassValues) {
     expect_near(s.equilateral, {q, q, 0}, 1e-12);
     EXPECT_EQ(s.meccano_histogram.counts.size(), 20u);
     EXPECT_EQ(s.meccano_histogram.counts.back(), s.tets);  // q = 1 goes to the last bin
-    EXPECT_EQ(*std::max_element(s.equilateral_histogram.counts.begin(), s.equilateral_histogram.counts.end()),
-              s.tets);
+    EXPECT_EQ(*std::max_element(s.equilateral_histogram.counts.begin(), s.equilateral_histogram.counts.end()), s.tets);
     EXPECT_GE(s.min_dihedral_deg, 45 - 1e-9);  // the bounds of the Kuhn classes
     EXPECT_LE(s.max_dihedral_deg, 120 + 1e-9);
   }

@@ -10,13 +10,13 @@
 // held below the value measured on each case when this test was written, rounded up by a few degrees,
 // so that a change that brings back the chords across creases fails.
 
+#include <meccano/inspect/mesh_file_measure.hpp>
+#include <meccano/io/mesh_writers.hpp>
 #include <meccano/io/surface_readers.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/mesh/invariants.hpp>
-#include <meccano/io/mesh_writers.hpp>
-#include <meccano/inspect/mesh_file_measure.hpp>
-#include <meccano/stages/pipeline.hpp>
 #include <meccano/mesh/quality.hpp>
+#include <meccano/stages/pipeline.hpp>
 
 #include <scratch_directory.hpp>
 #include <test_surfaces.hpp>
@@ -48,7 +48,9 @@ constexpr double maximum_dihedral_deg = 164.0;
 
 void PrintTo(const RealCase& c, std::ostream* os) { *os << c.name; }
 
-std::string hard_surface(const std::string& name) { return std::string(MECCANO_TEST_DATA_DIR) + "/hard_surfaces/" + name; }
+std::string hard_surface(const std::string& name) {
+  return std::string(MECCANO_TEST_DATA_DIR) + "/hard_surfaces/" + name;
+}
 
 class RealSurface : public testing::ScratchDirectoryTest, public ::testing::WithParamInterface<RealCase> {
  protected:
@@ -93,13 +95,14 @@ TEST_P(RealSurface, IsInsertedValidFaithfulAndAsEstimated) {
 
 INSTANTIATE_TEST_SUITE_P(
     FastSubset, RealSurface,
-    ::testing::Values(RealCase{"East_Huasna_E50", "CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts", true, 50, 20},
-                      RealCase{"Pipes_Canyon_E30", "MJVA-HSLZ-SBMT-Pipes_Canyon_fault_north_extension-CFM5_1000m.ts", true, 30, 25},
-                      RealCase{"Malibu_Coast_E30", "WTRA-SFFS-ANCP-Malibu_Coast_fault_west_steep_alt2-CFM5_1000m.ts", true, 30, 18},
-                      RealCase{"creased_E30", hard_surface("creased.obj"), false, 30, 25},
-                      RealCase{"low_dip_E30", hard_surface("low_dip.obj"), false, 30, 6},
-                      RealCase{"thin_long_E30", hard_surface("thin_long.obj"), false, 30, 3},
-                      RealCase{"vertical_E30", hard_surface("vertical.obj"), false, 30, 3}),
+    ::testing::Values(
+        RealCase{"East_Huasna_E50", "CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts", true, 50, 20},
+        RealCase{"Pipes_Canyon_E30", "MJVA-HSLZ-SBMT-Pipes_Canyon_fault_north_extension-CFM5_1000m.ts", true, 30, 25},
+        RealCase{"Malibu_Coast_E30", "WTRA-SFFS-ANCP-Malibu_Coast_fault_west_steep_alt2-CFM5_1000m.ts", true, 30, 18},
+        RealCase{"creased_E30", hard_surface("creased.obj"), false, 30, 25},
+        RealCase{"low_dip_E30", hard_surface("low_dip.obj"), false, 30, 6},
+        RealCase{"thin_long_E30", hard_surface("thin_long.obj"), false, 30, 3},
+        RealCase{"vertical_E30", hard_surface("vertical.obj"), false, 30, 3}),
     [](const ::testing::TestParamInfo<RealCase>& test) { return test.param.name; });
 
 }  // namespace

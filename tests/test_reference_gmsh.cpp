@@ -4,8 +4,8 @@
 // near the surface, and the error paths.
 
 #include <meccano/geometry/geometry.hpp>
-#include <meccano/mesh/quality.hpp>
 #include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/quality.hpp>
 
 #include <run_command.hpp>
 #include <scratch_directory.hpp>
@@ -102,8 +102,8 @@ MshContents read_msh(const std::string& path) {
       gmsh::model::mesh::getElementsByType(dim == 3 ? 4 : 2, element_tags, element_nodes, entity);
       if (dim == 3 && name == "domain") {
         for (std::size_t e = 0; e < element_tags.size(); ++e)
-          contents.tets.push_back({element_nodes[4 * e], element_nodes[4 * e + 1], element_nodes[4 * e + 2],
-                                   element_nodes[4 * e + 3]});
+          contents.tets.push_back(
+              {element_nodes[4 * e], element_nodes[4 * e + 1], element_nodes[4 * e + 2], element_nodes[4 * e + 3]});
       } else if (dim == 2) {
         auto& triangles = contents.triangles_of_group[name];
         for (std::size_t e = 0; e < element_tags.size(); ++e)
@@ -195,7 +195,8 @@ TEST_F(ReferenceGmshCubeTest, InterfaceIsTheSurfaceAsGivenOnInteriorFaces) {
     for (std::size_t node : face)
       ASSERT_LE(std::sqrt(tree.closest_point(mesh_.point_of_tag[node]).squared_distance), 1e-9) << "node " << node;
     const auto corners = smallest_first({input_vertex(face[0]), input_vertex(face[1]), input_vertex(face[2])});
-    EXPECT_TRUE(input_triangles.count(corners)) << "an interface triangle is not an input triangle in the input's orientation";
+    EXPECT_TRUE(input_triangles.count(corners))
+        << "an interface triangle is not an input triangle in the input's orientation";
     matched.insert(corners);
     const auto found = tets_of_face.find(sorted(face));
     ASSERT_NE(found, tets_of_face.end()) << "an interface triangle is not a face of any tet";
@@ -257,8 +258,9 @@ TEST_F(ReferenceGmshCliTest, TwoSurfacesWithTheCommaBoxAndDelaunay) {
   const auto pair = testing::stacked_pair(4);
   std::vector<std::string> files;
   for (const auto& surface : pair) files.push_back(write_obj(surface, surface.name + std::to_string(files.size())));
-  const ToolRun run = run_reference_gmsh("--box 0,0,0,1,1,1 --surface " + files[0] + " --surface " + files[1] +
-                                         ":top --size 0.25 --algorithm delaunay --threads 2 --output " + path("pair.msh"));
+  const ToolRun run =
+      run_reference_gmsh("--box 0,0,0,1,1,1 --surface " + files[0] + " --surface " + files[1] +
+                         ":top --size 0.25 --algorithm delaunay --threads 2 --output " + path("pair.msh"));
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_NE(run.output.find("Delaunay"), std::string::npos) << "progress names the algorithm\n" << run.output;
   const MshContents pair_mesh = read_msh(path("pair.msh"));
@@ -299,8 +301,8 @@ TEST_F(ReferenceGmshCliTest, SizeFieldMakesTheTetsNearTheSurfaceSmaller) {
   const TriangleBVH tree(patch);
   const double without_field = mean_edge_of_tets_between(read_msh(path("plain.msh")), tree, 0.1, 0.3);
   const double with_field = mean_edge_of_tets_between(read_msh(path("graded.msh")), tree, 0.1, 0.3);
-  EXPECT_LT(with_field, 0.75 * without_field) << "tets 0.1 to 0.3 away from S: mean edge " << with_field
-                                              << " with the field, " << without_field << " without";
+  EXPECT_LT(with_field, 0.75 * without_field)
+      << "tets 0.1 to 0.3 away from S: mean edge " << with_field << " with the field, " << without_field << " without";
 
   const auto report = [&](const std::string& name) {
     std::ifstream in(path(name));

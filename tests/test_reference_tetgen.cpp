@@ -7,8 +7,8 @@
 #include <meccano/geometry/geometry.hpp>
 #include <meccano/inspect/mesh_file_check.hpp>
 #include <meccano/io/msh_reader.hpp>
-#include <meccano/mesh/quality.hpp>
 #include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/quality.hpp>
 #include <meccano/mesh/tet_mesh.hpp>
 
 #include <run_command.hpp>
@@ -225,7 +225,8 @@ TEST_F(ReferenceTetgenCliTest, KeepSurfaceKeepsEveryInputTriangle) {
   const ToolRun run = run_on_pair_in_slab("--keep-surface --output " + path("kept.msh"));
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_NE(run.output.find("far above the volume bound"), std::string::npos)
-      << "with -Y TetGen 1.5 hardly refines, and the tool says so\n" << run.output;
+      << "with -Y TetGen 1.5 hardly refines, and the tool says so\n"
+      << run.output;
   expect_valid_reference_mesh(path("kept.msh"), pair_in_slab);
   const MshMesh mesh = read_msh_mesh(path("kept.msh"));
   for (const auto& surface : pair_in_slab) {
@@ -264,7 +265,8 @@ TEST_F(ReferenceTetgenCliTest, UsageErrorsExitTwoWithAMessage) {
   const std::map<std::string, std::string> cases{
       {"--surface a.obj --size 0.1" + rest, "--box is required"},
       {"--box 0 0 0 1 1 --surface a.obj --size 0.1" + rest, "--box takes 6 numbers"},
-      {"--box 0 1 0 1 0 1 --surface a.obj --size 0.1" + rest, "--box: on axis y the minimum 1 must be below the maximum 0"},
+      {"--box 0 1 0 1 0 1 --surface a.obj --size 0.1" + rest,
+       "--box: on axis y the minimum 1 must be below the maximum 0"},
       {"--box -1e308 0 0 1e308 1 1 --surface a.obj --size 0.1" + rest, "by a finite extent"},
       {"--box 0 0 0 1 1 1 --surface a.obj" + rest, "--size is required"},
       {valid + " --radius-edge 0.9" + rest, "--radius-edge must be at least 1"},

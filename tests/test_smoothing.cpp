@@ -3,14 +3,14 @@
 // S_M's nodes on S and its rim on the rim of S, S_M still a disk embedded in P, the paper's quality, and
 // the same mesh whatever the thread count.
 
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
+#include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/mesh/invariants.hpp>
+#include <meccano/mesh/quality.hpp>
 #include <meccano/report/insertion_report.hpp>
 #include <meccano/stages/pipeline.hpp>
-#include <meccano/mesh/quality.hpp>
 #include <meccano/stages/smoothing.hpp>
-#include <meccano/io/surface_readers.hpp>
 
 #include <test_surfaces.hpp>
 
@@ -51,8 +51,10 @@ TEST(Distortion, DerivativesMatchFiniteDifferences) {
         gradient[i] = (up.value - down.value) / (2 * step);
         hessian.col(i) = (up.gradient - down.gradient) / (2 * step);
       }
-      EXPECT_LE((gradient - exact.gradient).norm(), 1e-5 * (1 + exact.gradient.norm())) << "trial " << trial << " vertex " << k;
-      EXPECT_LE((hessian - exact.hessian).norm(), 1e-5 * (1 + exact.hessian.norm())) << "trial " << trial << " vertex " << k;
+      EXPECT_LE((gradient - exact.gradient).norm(), 1e-5 * (1 + exact.gradient.norm()))
+          << "trial " << trial << " vertex " << k;
+      EXPECT_LE((hessian - exact.hessian).norm(), 1e-5 * (1 + exact.hessian.norm()))
+          << "trial " << trial << " vertex " << k;
     }
   }
 }
@@ -107,7 +109,7 @@ TEST(Smoothing, UntanglesAScrambledMeshAndKeepsBoxNodesOnTheirSides) {
 
 TEST(Smoothing, ReportsAMeshItCannotUntangle) {
   TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);  // every node is a box corner: all fixed
-  mesh.points[0] = {2, 2, 2};  // past the opposite corner: every tet turns inside out
+  mesh.points[0] = {2, 2, 2};                                   // past the opposite corner: every tet turns inside out
   const SmoothingStats stats = smooth_mesh(mesh, {}, {.max_sweeps = 3});
   EXPECT_GT(stats.inverted_after, 0);
   EXPECT_FALSE(stats.untangled());
@@ -215,7 +217,8 @@ TEST(Smoothing, GivesTheSameMeshWithOneAndTwoThreads) {
   const InsertionResult two = insert({&surface, 1}, {{0, 0, 0}, {1, 1, 1}}, 1.0 / 24);
   omp_set_num_threads(threads);
   ASSERT_EQ(one.mesh.points.size(), two.mesh.points.size());
-  for (std::size_t v = 0; v < one.mesh.points.size(); ++v) ASSERT_EQ(one.mesh.points[v], two.mesh.points[v]) << "node " << v;
+  for (std::size_t v = 0; v < one.mesh.points.size(); ++v)
+    ASSERT_EQ(one.mesh.points[v], two.mesh.points[v]) << "node " << v;
   EXPECT_EQ(one.mesh.tets, two.mesh.tets);
   EXPECT_EQ(one.smoothing.sweeps.size(), two.smoothing.sweeps.size());
 }
@@ -293,8 +296,8 @@ TEST(Smoothing, FallsBackToTheEquilateralTargetWhereTheMeccanoTargetStalls) {
 
 TEST(Smoothing, UntanglesTowardsTheEquilateralTarget) {
   const TriangleSurface surface = testing::saddle(16);
-  const InsertionResult result = insert({&surface, 1}, {{0, 0, 0}, {1, 1, 1}}, 1.0 / 16,
-                                        {.target = SmoothingTarget::equilateral});
+  const InsertionResult result =
+      insert({&surface, 1}, {{0, 0, 0}, {1, 1, 1}}, 1.0 / 16, {.target = SmoothingTarget::equilateral});
   EXPECT_TRUE(result.smoothing.untangled());
   EXPECT_TRUE(verify_mesh(result.mesh, {.physical = true}).ok());
   EXPECT_EQ(folded_triangles(result.surfaces[0].projection), 0);

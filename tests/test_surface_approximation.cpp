@@ -3,10 +3,10 @@
 // configurations the healing rules remove, nodes close to S, oriented like S, the mesh conforming and
 // V_M still a ball.
 
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh/invariants.hpp>
 #include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/mesh/invariants.hpp>
 #include <meccano/stages/surface_approximation.hpp>
 
 #include <test_surfaces.hpp>
@@ -76,7 +76,8 @@ TEST_P(SurfaceApproximationOn, IsAHealedDiskCloseToSAndOrientedLikeIt) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllSurfacesAndBoxes, SurfaceApproximationOn, ::testing::ValuesIn(testing::surface_cases(16, true)),
+INSTANTIATE_TEST_SUITE_P(AllSurfacesAndBoxes, SurfaceApproximationOn,
+                         ::testing::ValuesIn(testing::surface_cases(16, true)),
                          [](const ::testing::TestParamInfo<Case>& param) { return param.param.name; });
 
 // Steps 1 and 2 for one surface in the unit cube's meccano.
@@ -158,8 +159,7 @@ TEST(SurfaceApproximation, EdgesToTheBoxAreSplitWhenTheSurfaceIsCloseToIt) {
 TEST(SurfaceApproximation, SurfaceSqueezedBetweenBoxSidesFailsClearly) {
   // A box 0.02 thick: V_M spans it, so neither side of S has room for S_M.
   const Box thin{{0, 0, 0}, {1, 1, 0.02}};
-  const TriangleSurface plane =
-      testing::graph_patch([](double, double) { return 0.01; }, {0.2, 0.8}, {0.2, 0.8}, 4);
+  const TriangleSurface plane = testing::graph_patch([](double, double) { return 0.01; }, {0.2, 0.8}, {0.2, 0.8}, 4);
   TetMesh mesh = make_cube_meccano(thin, {8, 8, 1}, 0);
   const TriangleBVH tree(plane);
   VolumetricStats volumetric_stats;

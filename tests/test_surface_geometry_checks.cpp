@@ -65,7 +65,8 @@ TEST(GeometryChecks, PerturbedSurfacesPass) {
 TEST(GeometryChecks, SheetPassingThroughItselfIntersects) {
   // A figure-eight profile (x, z) = (sin t, sin t cos t), t in [-0.3, pi + 0.3], extruded along y:
   // a topological disk crossing itself along the line x = z = 0.5.
-  TriangleSurface surface = testing::graph_patch([](double, double) { return 0.0; }, {0, 1}, {0, 1}, 24, "figure_eight");
+  TriangleSurface surface =
+      testing::graph_patch([](double, double) { return 0.0; }, {0, 1}, {0, 1}, 24, "figure_eight");
   for (Vector3d& p : surface.points) {
     const double t = -0.3 + p.x() * (std::numbers::pi + 0.6);
     p = Vector3d(0.5 + 0.3 * std::sin(t), 0.2 + 0.6 * p.y(), 0.5 + 0.3 * std::sin(t) * std::cos(t));
@@ -93,8 +94,8 @@ TEST(GeometryChecks, FoldedOverTrianglesIntersect) {
 TEST(GeometryChecks, SelfIntersectionNamesTrianglesOneBased) {
   TriangleSurface soup;
   soup.source = "soup.obj";
-  soup.points = {Vector3d(0, 0, 0), Vector3d(1, 0, 0), Vector3d(0, 1, 0),          // triangle 1
-                 Vector3d(5, 5, 5), Vector3d(6, 5, 5), Vector3d(5, 6, 5),          // triangle 2, far away
+  soup.points = {Vector3d(0, 0, 0),      Vector3d(1, 0, 0),     Vector3d(0, 1, 0),   // triangle 1
+                 Vector3d(5, 5, 5),      Vector3d(6, 5, 5),     Vector3d(5, 6, 5),   // triangle 2, far away
                  Vector3d(0.2, 0.2, -1), Vector3d(0.2, 0.2, 1), Vector3d(2, 2, 0)};  // triangle 3 crosses 1
   soup.triangles = {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}};
   EXPECT_EQ(error_of([&] { require_no_self_intersection(soup); }), "soup.obj: triangles 1 and 3 intersect");
@@ -136,11 +137,13 @@ TEST(GeometryChecks, CrossingSurfacesIntersect) {
   EXPECT_MESSAGE_HAS(message, " of paper_like, triangle ");
   // Crossing at right angles.
   const TriangleSurface wall = testing::near_vertical_patch(5);
-  EXPECT_MESSAGE_HAS(error_of([&] { require_surfaces_disjoint(wall, plane); }), "near_vertical and plane.off intersect");
+  EXPECT_MESSAGE_HAS(error_of([&] { require_surfaces_disjoint(wall, plane); }),
+                     "near_vertical and plane.off intersect");
 }
 
 TEST(GeometryChecks, TouchingSurfacesTouch) {
-  const TriangleSurface floor = testing::graph_patch([](double, double) { return 0.5; }, {0.2, 0.8}, {0.2, 0.8}, 5, "floor");
+  const TriangleSurface floor =
+      testing::graph_patch([](double, double) { return 0.5; }, {0.2, 0.8}, {0.2, 0.8}, 5, "floor");
   // Parallel, 1e-11 above the floor.
   const TriangleSurface lid =
       testing::graph_patch([](double, double) { return 0.5 + 1e-11; }, {0.3, 0.6}, {0.3, 0.6}, 3, "lid");

@@ -2,9 +2,9 @@
 #include <meccano/error.hpp>
 #include <meccano/io/surface_readers.hpp>
 
-#include <Eigen/Geometry>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
@@ -52,7 +52,9 @@ Eigen::Vector3d area_vector(const TriangleSurface& surface) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const auto& t : surface.triangles) {
     const Eigen::Vector3d& a = surface.points[static_cast<std::size_t>(t[0])];
-    sum += 0.5 * (surface.points[static_cast<std::size_t>(t[1])] - a).cross(surface.points[static_cast<std::size_t>(t[2])] - a);
+    sum +=
+        0.5 *
+        (surface.points[static_cast<std::size_t>(t[1])] - a).cross(surface.points[static_cast<std::size_t>(t[2])] - a);
   }
   return sum;
 }
@@ -181,7 +183,8 @@ std::string msh22_bytes(const TriangleSurface& surface, bool binary) {
     }
   } else {
     for (const std::int32_t value : {15, 1, 2, 1, 0, 1, static_cast<std::int32_t>(node_tag(0))}) put_native(out, value);
-    for (const std::int32_t value : {1, 1, 2, 2, 0, 1, static_cast<std::int32_t>(node_tag(0)), static_cast<std::int32_t>(node_tag(1))})
+    for (const std::int32_t value :
+         {1, 1, 2, 2, 0, 1, static_cast<std::int32_t>(node_tag(0)), static_cast<std::int32_t>(node_tag(1))})
       put_native(out, value);
     for (const std::int32_t value : {2, static_cast<std::int32_t>(triangles), 2}) put_native(out, value);
     for (std::size_t t = 0; t < triangles; ++t) {
@@ -208,7 +211,8 @@ struct Msh41Writer {
   }
   // Entity dimension and tag, a third int (parametric flag or element type), and the block's size.
   void block_header(std::int32_t dimension, std::int32_t third, std::uint64_t count) {
-    for (const std::int32_t value : {dimension, 1, third}) binary ? put_native(out, value) : void(out += std::to_string(value) + " ");
+    for (const std::int32_t value : {dimension, 1, third})
+      binary ? put_native(out, value) : void(out += std::to_string(value) + " ");
     sizes({count});
   }
   void end_line() {
@@ -453,7 +457,8 @@ TEST_F(SurfaceIo, ObjIndexZero) {
 }
 
 TEST_F(SurfaceIo, ObjMalformedNumber) {
-  EXPECT_THAT(read_error("bad.obj", "# header\nv 0 0 0\nv 1 0x 0\n"), HasSubstr("bad.obj:3: malformed coordinate '0x'"));
+  EXPECT_THAT(read_error("bad.obj", "# header\nv 0 0 0\nv 1 0x 0\n"),
+              HasSubstr("bad.obj:3: malformed coordinate '0x'"));
   EXPECT_THAT(read_error("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 a/1\n"),
               HasSubstr("bad.obj:4: malformed vertex index 'a'"));
 }
@@ -515,7 +520,8 @@ TEST_F(SurfaceIo, StlAsciiStructureErrorsNameTheLine) {
               HasSubstr("a.stl:7: expected 'endloop', found 'endfacet'"));
   EXPECT_THAT(read_error("b.stl", facet_start + "endloop\nendfacet\nendsolid\n"),
               HasSubstr("b.stl:6: expected 'vertex', found 'endloop'"));
-  EXPECT_THAT(read_error("c.stl", facet_start + "vertex 0 1 zero\n"), HasSubstr("c.stl:6: malformed coordinate 'zero'"));
+  EXPECT_THAT(read_error("c.stl", facet_start + "vertex 0 1 zero\n"),
+              HasSubstr("c.stl:6: malformed coordinate 'zero'"));
   EXPECT_THAT(read_error("d.stl", facet_start + "vertex 0 1 inf\n"), HasSubstr("d.stl:6: non-finite coordinate 'inf'"));
   EXPECT_THAT(read_error("e.stl", facet_start + "vertex 0 1 0\nendloop\nendfacet\n"),
               HasSubstr("e.stl:8: unexpected end of file (expected 'facet' or 'endsolid')"));
@@ -547,7 +553,8 @@ TEST_F(SurfaceIo, OffUnexpectedEndOfFile) {
 TEST_F(SurfaceIo, OffMalformedHeaderCountsAndFaces) {
   EXPECT_THAT(read_error("a.off", "PLY\n3 1 0\n"), HasSubstr("a.off:1: expected the 'OFF' header, found 'PLY'"));
   EXPECT_THAT(read_error("b.off", "OFF\n3 one 0\n"), HasSubstr("b.off:2: malformed face count 'one'"));
-  EXPECT_THAT(read_error("c.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n"), HasSubstr("c.off:6: face with 2 vertices"));
+  EXPECT_THAT(read_error("c.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n"),
+              HasSubstr("c.off:6: face with 2 vertices"));
   EXPECT_THAT(read_error("d.off", "OFF\n3 1 0\n0 0 0\n1 -nan 0\n0 1 0\n3 0 1 2\n"),
               HasSubstr("d.off:4: non-finite coordinate '-nan'"));
 }
@@ -609,7 +616,8 @@ TEST_F(SurfaceIo, MshBinaryFlagsAndEndianness) {
   EXPECT_THAT(read_error("size.msh", "$MeshFormat\n4.1 1 4\n"), HasSubstr("size.msh:2: unsupported data size '4'"));
   std::string swapped = msh41_bytes(grid_patch(), true);
   const std::size_t one = swapped.find("8\n") + 2;
-  std::reverse(swapped.begin() + static_cast<std::ptrdiff_t>(one), swapped.begin() + static_cast<std::ptrdiff_t>(one) + 4);
+  std::reverse(swapped.begin() + static_cast<std::ptrdiff_t>(one),
+               swapped.begin() + static_cast<std::ptrdiff_t>(one) + 4);
   EXPECT_THAT(read_error("swapped.msh", swapped),
               AllOf(HasSubstr("swapped.msh: byte "), HasSubstr(": binary endianness check reads 16777216")));
 }
@@ -635,15 +643,23 @@ TEST(SurfaceIoFaults, EverySharedFaultReadsWithItsCountsAndExtent) {
   };
   const Fault faults[] = {
       {"CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts", 1161, 664, {182.5, 224.6, 3853.2, 3911.8, -7.2, 0.9}},
-      {"MJVA-HSLZ-SBMT-Pipes_Canyon_fault_north_extension-CFM5_1000m.ts", 584, 322,
+      {"MJVA-HSLZ-SBMT-Pipes_Canyon_fault_north_extension-CFM5_1000m.ts",
+       584,
+       322,
        {518.2, 526.9, 3795.2, 3802.8, -10.4, 1.6}},
       {"PNRA-CRSF-YUHA-Shell_Beds_fault-CFM5_1000m.ts", 317, 182, {606.0, 609.5, 3618.3, 3624.3, -7.1, 0.1}},
       {"PNRA-SJFZ-SJCV-Claremont_fault-CFM4_1000m.ts", 2625, 1383, {482.6, 508.8, 3733.0, 3759.9, -18.8, 0.7}},
-      {"PNRA-SJFZ-SJCV-San_Jacinto_Claremont_fault_east-CFM4_1000m.ts", 1258, 680,
+      {"PNRA-SJFZ-SJCV-San_Jacinto_Claremont_fault_east-CFM4_1000m.ts",
+       1258,
+       680,
        {483.1, 490.8, 3753.3, 3760.5, -17.5, 0.7}},
-      {"WTRA-SFFS-ANCP-Malibu_Coast_fault_west_steep_alt2-CFM5_1000m.ts", 1022, 559,
+      {"WTRA-SFFS-ANCP-Malibu_Coast_fault_west_steep_alt2-CFM5_1000m.ts",
+       1022,
+       559,
        {289.1, 321.3, 3762.1, 3771.3, -13.4, 0.0}},
-      {"WTRA-SFFS-SRSM-Western_Santa_Cruz_Island_fault_trim-CFM5_1000m.ts", 788, 476,
+      {"WTRA-SFFS-SRSM-Western_Santa_Cruz_Island_fault_trim-CFM5_1000m.ts",
+       788,
+       476,
        {166.4, 227.7, 3771.8, 3792.0, -8.0, -0.1}},
       {"WTRA-SMFZ-SMDE-Sierra_Madre_fault_low_dip-CFM4_1000m.ts", 894, 482, {423.5, 430.1, 3776.5, 3787.3, -14.8, 0.7}},
   };
@@ -667,45 +683,43 @@ TEST(SurfaceIoFaults, EverySharedFaultReadsWithItsCountsAndExtent) {
 }
 
 // The lines before the geometry, numbered: a HEADER block, a coordinate system, properties, a comment.
-const std::string kTsurfHeader =
-    "GOCAD TSurf 1\n"                                            // 1
-    "HEADER {\n"                                                 // 2
-    "name: square fault\n"                                       // 3
-    "*solid*color:#87ceeb\n"                                     // 4
-    "}\n"                                                        // 5
-    "GOCAD_ORIGINAL_COORDINATE_SYSTEM\n"                         // 6
-    "NAME Default\n"                                             // 7
-    "AXIS_NAME \"X\" \"Y\" \"Z\"\n"                              // 8
-    "AXIS_UNIT \"m\" \"m\" \"m\"\n"                              // 9
-    "ZPOSITIVE Depth\n"                                          // 10
-    "END_ORIGINAL_COORDINATE_SYSTEM\n"                           // 11
-    "PROPERTIES a b\n"                                           // 12
-    "PROPERTY_CLASS_HEADER a {\n"                                // 13
-    "low_clip:0\n"                                               // 14
-    "}\n"                                                        // 15
-    "# a comment\n";                                             // 16
+const std::string kTsurfHeader = "GOCAD TSurf 1\n"                     // 1
+                                 "HEADER {\n"                          // 2
+                                 "name: square fault\n"                // 3
+                                 "*solid*color:#87ceeb\n"              // 4
+                                 "}\n"                                 // 5
+                                 "GOCAD_ORIGINAL_COORDINATE_SYSTEM\n"  // 6
+                                 "NAME Default\n"                      // 7
+                                 "AXIS_NAME \"X\" \"Y\" \"Z\"\n"       // 8
+                                 "AXIS_UNIT \"m\" \"m\" \"m\"\n"       // 9
+                                 "ZPOSITIVE Depth\n"                   // 10
+                                 "END_ORIGINAL_COORDINATE_SYSTEM\n"    // 11
+                                 "PROPERTIES a b\n"                    // 12
+                                 "PROPERTY_CLASS_HEADER a {\n"         // 13
+                                 "low_clip:0\n"                        // 14
+                                 "}\n"                                 // 15
+                                 "# a comment\n";                      // 16
 
 // A square's two triangles in TFACE 1 (vertices 10, 20, 30, 40) and, on the edge 20-30, a triangle
 // in TFACE 2 (vertex 50 and atoms of 20 and 30), then the same triangle reversed.
 TEST_F(SurfaceIo, TsurfWithPropertiesAtomsAndTwoTfacesSharingAnEdgeIsOneSurface) {
-  const std::string text = kTsurfHeader +
-                           "TFACE\n"                                        // 17
-                           "PVRTX 10 0 0 100 1.5 2.5\n"                     // 18
-                           "PVRTX 20 10 0 100 1.5 2.5\n"                    // 19
-                           "VRTX 30 10 10 100 # corner\n"                   // 20
-                           "VRTX 40 0 10 100\n"                             // 21
-                           "TRGL 10 20 30\n"                                // 22
-                           "TRGL 10 30 40\n"                                // 23
-                           "BSTONE 10\n"                                    // 24
-                           "BORDER 41 10 20\n"                              // 25
-                           "TFACE\n"                                        // 26
-                           "PATOM 60 20 7 8\n"                              // 27
-                           "ATOM 70 30\n"                                   // 28
-                           "ATOM 80 70\n"                                   // 29
-                           "VRTX 50 20 5 100\n"                             // 30
-                           "TRGL 60 50 70\n"                                // 31
-                           "TRGL 50 60 80\n"                                // 32 (31 reversed)
-                           "END\n";
+  const std::string text = kTsurfHeader + "TFACE\n"                       // 17
+                                          "PVRTX 10 0 0 100 1.5 2.5\n"    // 18
+                                          "PVRTX 20 10 0 100 1.5 2.5\n"   // 19
+                                          "VRTX 30 10 10 100 # corner\n"  // 20
+                                          "VRTX 40 0 10 100\n"            // 21
+                                          "TRGL 10 20 30\n"               // 22
+                                          "TRGL 10 30 40\n"               // 23
+                                          "BSTONE 10\n"                   // 24
+                                          "BORDER 41 10 20\n"             // 25
+                                          "TFACE\n"                       // 26
+                                          "PATOM 60 20 7 8\n"             // 27
+                                          "ATOM 70 30\n"                  // 28
+                                          "ATOM 80 70\n"                  // 29
+                                          "VRTX 50 20 5 100\n"            // 30
+                                          "TRGL 60 50 70\n"               // 31
+                                          "TRGL 50 60 80\n"               // 32 (31 reversed)
+                                          "END\n";
   meccano::SurfaceReadReport report;
   const std::string path = write("square.ts", text);
   const TriangleSurface read = meccano::read_surface(path, {}, &report);
@@ -728,29 +742,28 @@ TEST_F(SurfaceIo, TsurfWithPropertiesAtomsAndTwoTfacesSharingAnEdgeIsOneSurface)
 
 // Two triangles apart in TFACE 1, one in TFACE 2 joined by an edge to the second of TFACE 1, and one
 // of a second object (its own ids, no name) alone: parts {1}, {2, 3}, {4} in file order.
-const std::string kThreePartTsurf =
-    "GOCAD TSurf 1\n"           // 1
-    "HEADER {name:faults}\n"    // 2
-    "TFACE\n"                   // 3
-    "VRTX 1 0 0 0\n"            // 4
-    "VRTX 2 1 0 0\n"            // 5
-    "VRTX 3 0 1 0\n"            // 6
-    "VRTX 4 5 0 0\n"            // 7
-    "VRTX 5 6 0 0\n"            // 8
-    "VRTX 6 5 1 0\n"            // 9
-    "TRGL 1 2 3\n"              // 10
-    "TRGL 4 5 6\n"              // 11
-    "TFACE\n"                   // 12
-    "VRTX 7 6 1 0\n"            // 13
-    "TRGL 6 5 7\n"              // 14
-    "END\n"                     // 15
-    "GOCAD TSurf 1\n"           // 16
-    "TFACE\n"                   // 17
-    "VRTX 1 0 0 9\n"            // 18
-    "VRTX 2 1 0 9\n"            // 19
-    "VRTX 3 0 1 9\n"            // 20
-    "TRGL 1 2 3\n"              // 21
-    "END\n";
+const std::string kThreePartTsurf = "GOCAD TSurf 1\n"         // 1
+                                    "HEADER {name:faults}\n"  // 2
+                                    "TFACE\n"                 // 3
+                                    "VRTX 1 0 0 0\n"          // 4
+                                    "VRTX 2 1 0 0\n"          // 5
+                                    "VRTX 3 0 1 0\n"          // 6
+                                    "VRTX 4 5 0 0\n"          // 7
+                                    "VRTX 5 6 0 0\n"          // 8
+                                    "VRTX 6 5 1 0\n"          // 9
+                                    "TRGL 1 2 3\n"            // 10
+                                    "TRGL 4 5 6\n"            // 11
+                                    "TFACE\n"                 // 12
+                                    "VRTX 7 6 1 0\n"          // 13
+                                    "TRGL 6 5 7\n"            // 14
+                                    "END\n"                   // 15
+                                    "GOCAD TSurf 1\n"         // 16
+                                    "TFACE\n"                 // 17
+                                    "VRTX 1 0 0 9\n"          // 18
+                                    "VRTX 2 1 0 9\n"          // 19
+                                    "VRTX 3 0 1 9\n"          // 20
+                                    "TRGL 1 2 3\n"            // 21
+                                    "END\n";
 
 TEST_F(SurfaceIo, TsurfOfSeveralPartsIsRefusedNamingEachPart) {
   const std::string message = read_error("parts.ts", kThreePartTsurf);
@@ -870,7 +883,7 @@ TEST_F(SurfaceIo, TsurfErrorsNameTheLineAndTheDefect) {
       {"GOCAD PLine 1\nHEADER {name:trace}\nEND\n", "bad.ts:1: not a TSurf: a GOCAD 'PLine' object"},
       {start + "VRTX 3 0 1 0\nTRGL 1 2 3\nEND\nGOCAD Well 1\n", "bad.ts:8: not a TSurf: a GOCAD 'Well' object"},
       {start + "VRTX 3 0 1 0\nTRGL 1 2 3\nEND\nTFACE\n", "bad.ts:8: expected 'GOCAD TSurf' (another object) or the end "
-                                                        "of the file after END, found 'TFACE'"},
+                                                         "of the file after END, found 'TFACE'"},
       {start + "VRTX 3 0 1 0\nTRGL 1 2 3\n", "bad.ts:6: unexpected end of file (expected 'END' of the object that "
                                              "starts at line 1)"},
       {start + "GOCAD TSurf 1\n",

@@ -2,9 +2,9 @@
 #include <meccano/error.hpp>
 #include <meccano/surface/validation.hpp>
 
-#include <Eigen/Geometry>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <limits>
@@ -136,7 +136,8 @@ TEST(SurfaceTopology, NonFiniteCoordinate) {
 TEST(SurfaceTopology, IndexOutOfRange) {
   TriangleSurface surface = grid_patch();
   surface.triangles[1][2] = 25;
-  EXPECT_THAT(topology_error(surface), HasSubstr("patch.obj: triangle 2 refers to vertex 26, out of range (the surface has vertices 1..25)"));
+  EXPECT_THAT(topology_error(surface),
+              HasSubstr("patch.obj: triangle 2 refers to vertex 26, out of range (the surface has vertices 1..25)"));
   surface.triangles[1][2] = -1;
   EXPECT_THAT(topology_error(surface), HasSubstr("triangle 2 refers to vertex 0, out of range"));
 }
@@ -209,7 +210,8 @@ TEST(SurfaceTopology, TwoFansOfAGridTouchingAtACorner) {
     for (int& v : triangle) v = v == 0 ? 8 : v + offset;  // the other grid's first point is this grid's last
     surface.triangles.push_back(triangle);
   }
-  EXPECT_THAT(topology_error(surface), HasSubstr("patch.obj: non-manifold vertex 9: its triangles form 2 separate fans"));
+  EXPECT_THAT(topology_error(surface),
+              HasSubstr("patch.obj: non-manifold vertex 9: its triangles form 2 separate fans"));
 }
 
 TEST(SurfaceTopology, ClosedSurface) {

@@ -112,8 +112,8 @@ class TagNumbering : public testing::ScratchDirectoryTest {
 TEST_F(TagNumbering, EveryFormatOfTheModuleNumbersTheGroupsAlike) {
   const testing::CommandRun run =
       testing::run_command(std::string(MECCANO_CLI) + " --box 0,0,0,1,1,1 --resolution 0.1 --quiet" + surfaces_ +
-                           " --output " + path("a.msh") + " --output " + path("a.vtu") + " --output " +
-                           path("a.mesh") + " --msh-version 2.2 --output " + path("a22.msh"));
+                           " --output " + path("a.msh") + " --output " + path("a.vtu") + " --output " + path("a.mesh") +
+                           " --msh-version 2.2 --output " + path("a22.msh"));
   ASSERT_EQ(run.status, 0) << run.output;
   const std::map<std::string, GroupNumbers> files{{"a.msh", numbers_in_msh(path("a.msh"))},
                                                   {"a22.msh", numbers_in_msh(path("a22.msh"))},

@@ -2,10 +2,10 @@
 // V_M contains S, is a topological ball with axis-parallel boundary faces, every tet meeting S is
 // shorter than l_r, and the mesh stays conforming. Regions of earlier surfaces follow refinement.
 
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh/invariants.hpp>
 #include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/mesh/invariants.hpp>
 #include <meccano/stages/volumetric_approximation.hpp>
 
 #include <test_surfaces.hpp>
@@ -96,15 +96,15 @@ void expect_valid_approximation(const TetMesh& mesh, const TriangleSurface& surf
     if (bvh.intersects_tetrahedron(mesh.tet_points(t))) {
       ASSERT_TRUE(region[t]) << "tet " << t << " meets S but is not in V_M";
       ASSERT_LT(mesh.longest_edge(t), resolution) << "tet " << t << " meets S and is too long";
-      ASSERT_GE(mesh.level(t), level_for_resolution(mesh.meccano, resolution)) << "tet " << t << " is coarser than V_M's level";
+      ASSERT_GE(mesh.level(t), level_for_resolution(mesh.meccano, resolution))
+          << "tet " << t << " is coarser than V_M's level";
     }
   }
   // Independently of the intersection test: vertices and centroids of S lie in tets of V_M.
   const RegionLocator locator(mesh, region);
   for (std::size_t i = 0; i < surface.triangles.size(); ++i) {
     const auto& tri = surface.triangles[i];
-    const Eigen::Vector3d centroid =
-        (surface.points[tri[0]] + surface.points[tri[1]] + surface.points[tri[2]]) / 3.0;
+    const Eigen::Vector3d centroid = (surface.points[tri[0]] + surface.points[tri[1]] + surface.points[tri[2]]) / 3.0;
     for (const Eigen::Vector3d& x : {centroid, surface.points[tri[0]]}) {
       ASSERT_TRUE(locator.contains(x)) << "point (" << x.transpose() << ") of triangle " << i << " is outside V_M";
     }
@@ -137,7 +137,8 @@ TEST_P(VolumetricOnSurface, IsABallContainingSWithFineTetsNearS) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllSurfacesAndBoxes, VolumetricOnSurface, ::testing::ValuesIn(testing::surface_cases(16, false)),
+INSTANTIATE_TEST_SUITE_P(AllSurfacesAndBoxes, VolumetricOnSurface,
+                         ::testing::ValuesIn(testing::surface_cases(16, false)),
                          [](const ::testing::TestParamInfo<Case>& param) { return param.param.name; });
 
 TEST(VolumetricApproximation, PerturbedSurfacesGiveBallsToo) {
@@ -174,7 +175,8 @@ TEST(BallCheck, DetectsPinchedAndDisconnectedRegions) {
     for (TetId a : star)
       for (TetId b : star) {
         int common = 0;
-        for (VertexId x : mesh.tets[a]) common += static_cast<int>(std::count(mesh.tets[b].begin(), mesh.tets[b].end(), x));
+        for (VertexId x : mesh.tets[a])
+          common += static_cast<int>(std::count(mesh.tets[b].begin(), mesh.tets[b].end(), x));
         if (common == 1 && second == no_tet) first = a, second = b;
       }
   }
@@ -227,7 +229,8 @@ TEST(GrowIntoBall, JoinsTetsThatShareOnlyAVertex) {
   region[star.front()] = 1;
   for (TetId t : star) {  // a second tet of the star sharing only the centre with the first
     int common = 0;
-    for (VertexId v : mesh.tets[t]) common += static_cast<int>(std::count(mesh.tets[star.front()].begin(), mesh.tets[star.front()].end(), v));
+    for (VertexId v : mesh.tets[t])
+      common += static_cast<int>(std::count(mesh.tets[star.front()].begin(), mesh.tets[star.front()].end(), v));
     if (common == 1) {
       region[t] = 1;
       break;
@@ -252,9 +255,8 @@ TEST(GrowIntoBall, FillsAHollowShell) {
 TEST(GrowIntoBall, ClosesASolidTorus) {
   TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 9);
   // A ring of 8 cells around an empty one, one cell thick: boundary Euler characteristic 0.
-  const TetRegion ring = cells_region(mesh, [](int i, int j, int k) {
-    return k == 4 && i >= 3 && i <= 5 && j >= 3 && j <= 5 && !(i == 4 && j == 4);
-  });
+  const TetRegion ring = cells_region(
+      mesh, [](int i, int j, int k) { return k == 4 && i >= 3 && i <= 5 && j >= 3 && j <= 5 && !(i == 4 && j == 4); });
   const BallCheck before = check_ball(mesh, ring);
   EXPECT_EQ(before.boundary_euler, 0);
   EXPECT_EQ(before.non_disk_links, 0) << "the link test alone cannot see a handle";

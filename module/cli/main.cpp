@@ -1,17 +1,17 @@
 // meccano-immerse: the command-line front end of the module.
 // Exit status: 0 success, 1 failure (bad input data, meshing failed, cannot write), 2 usage error.
 
-#include <meccano/io/atomic_file.hpp>
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
-#include <meccano/mesh/invariants.hpp>
-#include <meccano/io/mesh_writers.hpp>
 #include <meccano/inspect/mesh_file_check.hpp>
 #include <meccano/inspect/mesh_file_measure.hpp>
+#include <meccano/io/atomic_file.hpp>
+#include <meccano/io/mesh_writers.hpp>
+#include <meccano/io/surface_readers.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/mesh/invariants.hpp>
 #include <meccano/report/insertion_report.hpp>
 #include <meccano/report/quality_csv.hpp>
 #include <meccano/stages/pipeline.hpp>
-#include <meccano/io/surface_readers.hpp>
 #include <meccano/surface/validation.hpp>
 
 #include "arguments.hpp"
@@ -429,7 +429,8 @@ int run(const Options& options) {
   const meccano::InsertionResult result = meccano::insert_surfaces(std::move(mesh), surfaces, insertion);
 
   // A tangled mesh is written only as the projection stage's inspection output.
-  const auto check = meccano::verify_mesh(result.mesh, {.physical = insertion.last_stage != meccano::Stage::projection});
+  const auto check =
+      meccano::verify_mesh(result.mesh, {.physical = insertion.last_stage != meccano::Stage::projection});
   if (!check.ok()) throw meccano::MeshingError("the mesh fails its invariant checks: " + check.summary());
 
   // The files appear together once all are written: a failed run leaves none, and leaves a file that
@@ -437,11 +438,13 @@ int run(const Options& options) {
   meccano::StagedFiles files;
   const auto groups = meccano::output_groups(result, insertion.last_stage);
   for (const auto& output : options.outputs)
-    files.write(output.path, [&](const std::string& path) { meccano::write_mesh(result.mesh, groups, path, output.format); });
+    files.write(output.path,
+                [&](const std::string& path) { meccano::write_mesh(result.mesh, groups, path, output.format); });
   if (options.histograms) {
     const std::pair<std::string, const meccano::QualitySummary*> labelled[] = {
         {"before_smoothing", &result.quality_before_smoothing}, {"after_smoothing", &result.quality_after_smoothing}};
-    files.write(*options.histograms, [&](const std::string& path) { meccano::write_quality_histograms_csv(path, labelled); });
+    files.write(*options.histograms,
+                [&](const std::string& path) { meccano::write_quality_histograms_csv(path, labelled); });
   }
   if (options.report) {
     const std::string report = meccano::insertion_report_json(result, insertion.last_stage);

@@ -25,8 +25,10 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--grid")) grid = std::atoi(argv[i + 1]);
 
   std::printf("| %-36s | %8s | %8s | %6s | %9s | %8s | %9s | %9s | %7s | %7s | %8s | %8s | %7s |\n", "case", "tets",
-              "inverted", "sweeps", "untangled", "fallback", "mec. min", "mec. mean", "η min", "η mean", "min dih.", "max dih.", "seconds");
-  std::printf("|--------------------------------------|----------|----------|--------|-----------|----------|-----------|-----------|---------|"
+              "inverted", "sweeps", "untangled", "fallback", "mec. min", "mec. mean", "η min", "η mean", "min dih.",
+              "max dih.", "seconds");
+  std::printf("|--------------------------------------|----------|----------|--------|-----------|----------|----------"
+              "-|-----------|---------|"
               "---------|----------|----------|---------|\n");
   int failed = 0, cases = 0;
   for (const meccano::testing::SurfaceCase& c : meccano::testing::surface_cases(grid, true)) {
@@ -38,10 +40,11 @@ int main(int argc, char** argv) {
           meccano::insert_surfaces(meccano::make_cube_meccano(c.box, 0), c.surfaces, options);
       const meccano::QualitySummary& q = r.quality_after_smoothing;
       const std::string fallback = r.smoothing.fallback_sweep > 0 ? std::to_string(r.smoothing.fallback_sweep) : "-";
-      std::printf("| %-36s | %8d | %8lld | %6zu | %9d | %8s | %9.3f | %9.3f | %7.3f | %7.3f | %7.1f° | %7.1f° | %7.2f |\n",
-                  c.name.c_str(), r.mesh.num_tets(), static_cast<long long>(r.smoothing.inverted_before),
-                  r.smoothing.sweeps.size(), r.smoothing.untangling_sweeps, fallback.c_str(), q.meccano.min, q.meccano.mean, q.equilateral.min, q.equilateral.mean,
-                  q.min_dihedral_deg, q.max_dihedral_deg, r.seconds);
+      std::printf(
+          "| %-36s | %8d | %8lld | %6zu | %9d | %8s | %9.3f | %9.3f | %7.3f | %7.3f | %7.1f° | %7.1f° | %7.2f |\n",
+          c.name.c_str(), r.mesh.num_tets(), static_cast<long long>(r.smoothing.inverted_before),
+          r.smoothing.sweeps.size(), r.smoothing.untangling_sweeps, fallback.c_str(), q.meccano.min, q.meccano.mean,
+          q.equilateral.min, q.equilateral.mean, q.min_dihedral_deg, q.max_dihedral_deg, r.seconds);
     } catch (const std::exception& failure) {
       ++failed;
       std::printf("| %-36s | failed: %s |\n", c.name.c_str(), failure.what());

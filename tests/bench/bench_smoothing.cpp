@@ -49,9 +49,15 @@ const char* mode_name(meccano::SmoothingMode mode) {
 
 Measurement measure(const meccano::InsertionResult& result) {
   const meccano::SurfaceInsertion& surface = result.surfaces.front();
-  return {result.mesh.num_tets(), result.mesh.num_vertices(), surface.volumetric_seconds,
-          surface.approximation_seconds, surface.projection_seconds, result.smoothing_seconds, result.seconds,
-          result.smoothing, result.quality_after_smoothing};
+  return {result.mesh.num_tets(),
+          result.mesh.num_vertices(),
+          surface.volumetric_seconds,
+          surface.approximation_seconds,
+          surface.projection_seconds,
+          result.smoothing_seconds,
+          result.seconds,
+          result.smoothing,
+          result.quality_after_smoothing};
 }
 
 // The repetition with the smallest total; the first failure ends the row.
@@ -78,7 +84,8 @@ Row insert(const meccano::TriangleSurface& surface, int inverse_resolution, mecc
 void print_timings(const std::vector<Row>& rows) {
   std::printf("| %8s | %6s | %10s | %9s | %7s | %7s | %7s | %8s | %7s | %8s |\n", "l_r", "mode", "tets", "nodes",
               "step 1", "step 2", "step 3", "smoothing", "checks", "total s");
-  std::printf("|----------|--------|------------|-----------|---------|---------|---------|----------|---------|----------|\n");
+  std::printf(
+      "|----------|--------|------------|-----------|---------|---------|---------|----------|---------|----------|\n");
   for (const Row& row : rows) {
     if (!row.best) {
       std::printf("| 1/%-6d | %6s | failed: %s |\n", row.inverse_resolution, mode_name(row.mode), row.error.c_str());
@@ -95,10 +102,11 @@ void print_timings(const std::vector<Row>& rows) {
 
 void print_smoothing(const std::vector<Row>& rows) {
   std::printf("\n| %8s | %6s | %10s | %10s | %6s | %10s | %10s | %9s | %9s | %9s | %9s | %8s |\n", "l_r", "mode",
-              "free nodes", "inverted", "sweeps", "untangling", "s/sweep", "mec. min", "mec. mean", "η min",
-              "η mean", "min dih.");
-  std::printf("|----------|--------|------------|------------|--------|------------|------------|-----------|-----------|"
-              "-----------|-----------|----------|\n");
+              "free nodes", "inverted", "sweeps", "untangling", "s/sweep", "mec. min", "mec. mean", "η min", "η mean",
+              "min dih.");
+  std::printf(
+      "|----------|--------|------------|------------|--------|------------|------------|-----------|-----------|"
+      "-----------|-----------|----------|\n");
   for (const Row& row : rows) {
     if (!row.best) continue;
     const meccano::SmoothingStats& s = row.best->smoothing;

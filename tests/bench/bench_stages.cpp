@@ -79,9 +79,10 @@ std::pair<double, double> boundary_distances(const meccano::TetMesh& mesh, const
 
 // The second table: the growth into a ball on every test surface.
 void measure_growth(double resolution) {
-  std::printf("\n| %-22s | %8s | %8s | %9s | %8s | %10s | %8s | %8s |\n", "surface (l_r = 1/32)", "tets", "V_M", "meet S",
-              "axis", "node stars", "max d/l_r", "mean d/l_r");
-  std::printf("|------------------------|----------|----------|-----------|----------|------------|----------|----------|\n");
+  std::printf("\n| %-22s | %8s | %8s | %9s | %8s | %10s | %8s | %8s |\n", "surface (l_r = 1/32)", "tets", "V_M",
+              "meet S", "axis", "node stars", "max d/l_r", "mean d/l_r");
+  std::printf(
+      "|------------------------|----------|----------|-----------|----------|------------|----------|----------|\n");
   for (const auto& named : meccano::testing::named_test_surfaces(24)) {
     meccano::TetMesh mesh = meccano::make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
     const meccano::TriangleBVH first(named.surfaces.front());
@@ -90,8 +91,7 @@ void measure_growth(double resolution) {
     const auto [largest, mean] = boundary_distances(mesh, region, first, resolution);
     std::printf("| %-22s | %8d | %8lld | %9lld | %8lld | %10lld | %8.2f | %8.2f |\n", named.name.c_str(),
                 mesh.num_tets(), static_cast<long long>(stats.tets), static_cast<long long>(stats.tets_intersecting),
-                static_cast<long long>(stats.axis_tets), static_cast<long long>(stats.euler_node_stars), largest,
-                mean);
+                static_cast<long long>(stats.axis_tets), static_cast<long long>(stats.euler_node_stars), largest, mean);
   }
 }
 
@@ -105,9 +105,10 @@ double area_of(const Points& points, const Triangles& triangles) {
 // The third table: S_M healed on every test surface.
 void measure_healing(double resolution) {
   std::printf("\n| %-22s | %6s | %6s | %5s | %6s | %5s | %5s | %5s | %6s | %5s | %5s | %5s | %5s | %7s | %6s |\n",
-              "S_M (l_r = 1/32)", "faces", "passes", "ext", "corbel", "fill", "left", "2face", "2rim",
-              "div", "chord", "cross", "max d", "S_M/S", "ms");
-  std::printf("|------------------------|--------|--------|-------|--------|-------|-------|-------|--------|-------|-------|-------|-------|---------|--------|\n");
+              "S_M (l_r = 1/32)", "faces", "passes", "ext", "corbel", "fill", "left", "2face", "2rim", "div", "chord",
+              "cross", "max d", "S_M/S", "ms");
+  std::printf("|------------------------|--------|--------|-------|--------|-------|-------|-------|--------|-------|--"
+              "-----|-------|-------|---------|--------|\n");
   for (const auto& named : meccano::testing::named_test_surfaces(24)) {
     meccano::TetMesh mesh = meccano::make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);
     const meccano::TriangleSurface& patch = named.surfaces.front();
@@ -122,13 +123,15 @@ void measure_healing(double resolution) {
     for (const auto& t : faces.triangles)
       for (meccano::VertexId v : t)
         largest = std::max(largest, std::sqrt(patch_tree.closest_point(mesh.points[v]).squared_distance));
-    std::printf("| %-22s | %6lld | %6d | %5lld | %6lld | %5lld | %5lld | %5lld | %6lld | %5lld | %5lld | %5lld | %5.2f | %7.2f | %6.1f |\n",
+    std::printf("| %-22s | %6lld | %6d | %5lld | %6lld | %5lld | %5lld | %5lld | %6lld | %5lld | %5lld | %5lld | %5.2f "
+                "| %7.2f | %6.1f |\n",
                 named.name.c_str(), static_cast<long long>(h.faces), h.passes,
                 static_cast<long long>(h.extension_faces), static_cast<long long>(h.corbels),
                 static_cast<long long>(h.reflex_corners_filled), static_cast<long long>(h.reflex_corners_left),
                 static_cast<long long>(h.tets_with_two_faces), static_cast<long long>(h.triangles_with_two_rim_edges),
                 static_cast<long long>(h.dividing_edges), static_cast<long long>(h.chord_edges),
-                static_cast<long long>(h.cross_surface_edges), largest / resolution, area_of(mesh.points, faces.triangles) / area_of(patch.points, patch.triangles), ms);
+                static_cast<long long>(h.cross_surface_edges), largest / resolution,
+                area_of(mesh.points, faces.triangles) / area_of(patch.points, patch.triangles), ms);
   }
 }
 

@@ -13,11 +13,11 @@
 // Usage: stress_surfaces [--seed S] [--cases K] [--first I] [--threads T] [--dump DIR]
 // Case i depends only on (S, i): `--first i --cases 1` reruns it alone; --dump writes each case's surfaces
 // to DIR/case<i>_<name>.obj with the meccano-immerse command that inserts them, to reproduce it there.
+#include <meccano/error.hpp>
+#include <meccano/geometry/geometry.hpp>
 #include <meccano/io/atomic_file.hpp>
 #include <meccano/mesh/box.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
-#include <meccano/error.hpp>
-#include <meccano/geometry/geometry.hpp>
 #include <meccano/mesh/invariants.hpp>
 #include <meccano/stages/pipeline.hpp>
 #include <meccano/stages/surface_approximation.hpp>
@@ -79,8 +79,8 @@ Options parse_options(int argc, char** argv) {
 // The shape of one surface in its local frame (u, v, height), lengths relative to its size R.
 struct HeightField {
   bool disk = true;
-  double size = 0.2;              // radius, or half-width along u
-  double aspect = 1.0;            // rectangle half-width along v, over `size`
+  double size = 0.2;                    // radius, or half-width along u
+  double aspect = 1.0;                  // rectangle half-width along v, over `size`
   double a_uu = 0, a_vv = 0, a_uv = 0;  // quadratic curvature terms
   double bump = 0, frequency = 1, phase_u = 0, phase_v = 0;
 
@@ -117,7 +117,8 @@ PlanarMesh disk_mesh(double radius, int rings) {
         const int inner = sector * (i - 1) + j;
         const int outer = sector * i + j;
         mesh.triangles.push_back({on_ring(i, outer), on_ring(i, outer + 1), on_ring(i - 1, inner)});
-        if (j + 1 < i) mesh.triangles.push_back({on_ring(i - 1, inner), on_ring(i, outer + 1), on_ring(i - 1, inner + 1)});
+        if (j + 1 < i)
+          mesh.triangles.push_back({on_ring(i - 1, inner), on_ring(i, outer + 1), on_ring(i - 1, inner + 1)});
       }
   return mesh;
 }
@@ -136,7 +137,9 @@ PlanarMesh rectangle_mesh(double half_u, double half_v, int cells_u, int cells_v
   return mesh;
 }
 
-double uniform(std::mt19937_64& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
 
 // A surface whose triangles are about `edge` long (at most 40 per radius: enough for the projection).
 TriangleSurface random_surface(std::mt19937_64& rng, double edge, const std::string& name) {
@@ -159,9 +162,10 @@ TriangleSurface random_surface(std::mt19937_64& rng, double edge, const std::str
       Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized().toRotationMatrix();
 
   const int divisions = std::clamp(static_cast<int>(std::ceil(field.size / edge)), 4, 40);
-  const PlanarMesh planar = field.disk ? disk_mesh(field.size, divisions)
-                                       : rectangle_mesh(field.size, field.size * field.aspect, divisions,
-                                                        std::max(2, static_cast<int>(std::ceil(divisions * field.aspect))));
+  const PlanarMesh planar = field.disk
+                                ? disk_mesh(field.size, divisions)
+                                : rectangle_mesh(field.size, field.size * field.aspect, divisions,
+                                                 std::max(2, static_cast<int>(std::ceil(divisions * field.aspect))));
   TriangleSurface surface;
   surface.name = name;
   for (const Eigen::Vector2d& q : planar.points)
@@ -195,7 +199,8 @@ std::string defects_of(const meccano::InsertionResult& result, const std::vector
     double worst = 0.0;
     for (const meccano::InterfaceFace& face : interfaces[s].faces)
       for (const meccano::VertexId v : face.vertices)
-        worst = std::max(worst, std::sqrt(bvh.closest_point(result.mesh.points[static_cast<std::size_t>(v)]).squared_distance));
+        worst = std::max(
+            worst, std::sqrt(bvh.closest_point(result.mesh.points[static_cast<std::size_t>(v)]).squared_distance));
     if (worst > tolerance) out << surfaces[s].name << ": an interface node is " << worst << " from S; ";
     const meccano::SurfaceApproximationCheck disk =
         meccano::check_surface_approximation(result.mesh, result.surfaces[s].volumetric, static_cast<int>(s));
@@ -208,7 +213,8 @@ std::string defects_of(const meccano::InsertionResult& result, const std::vector
 std::string finer_resolutions(const meccano::InsertionResult& result, double asked) {
   std::ostringstream out;
   for (const auto& inserted : result.surfaces)
-    if (inserted.resolution < asked) out << inserted.name << " at l_r = 1/" << std::lround(1.0 / inserted.resolution) << ' ';
+    if (inserted.resolution < asked)
+      out << inserted.name << " at l_r = 1/" << std::lround(1.0 / inserted.resolution) << ' ';
   return out.str();
 }
 
@@ -332,6 +338,7 @@ int main(int argc, char** argv) {
   for (const auto& [key, count] : counts)
     std::cout << "| " << outcome_name(key.first) << " | " << (key.second.empty() ? "-" : key.second) << " | " << count
               << " | " << one_decimal(100.0 * count / options.cases) << " % |\n";
-  const bool any_invalid = std::ranges::any_of(counts, [](const auto& entry) { return entry.first.first == Outcome::accepted_invalid; });
+  const bool any_invalid =
+      std::ranges::any_of(counts, [](const auto& entry) { return entry.first.first == Outcome::accepted_invalid; });
   return any_invalid ? 1 : 0;
 }

@@ -14,8 +14,8 @@
 // It prints the sizes, the area of S and the outflow, and exits 1 if S's faces do not add up to S's
 // triangles or the outflow is off by more than 25 % (the far field of these small meshes is coarse).
 
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/dealii_mesh.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/dofs/dof_handler.h>
@@ -191,7 +191,8 @@ int main(int argc, char** argv) {
       const std::vector<meccano::TriangleSurface> surfaces{curved_patch(8)};
       meccano::InsertionOptions options;
       options.resolution = 0.0625;
-      mesh = meccano::dealii_mesh(meccano::insert_surfaces(meccano::make_cube_meccano(unit_cube, 1), surfaces, options));
+      mesh =
+          meccano::dealii_mesh(meccano::insert_surfaces(meccano::make_cube_meccano(unit_cube, 1), surfaces, options));
     }
     FluxJump problem(mesh, mesh.interface(argc > 2 ? argv[2] : ""));
     const bool passed = problem.run();

@@ -48,7 +48,8 @@ bool decode_surface(ByteReader& in, meccano::TriangleSurface& surface) {
   const bool raw = (vertex_byte & 0x80) != 0;
   const int vertices = 1 + (vertex_byte & 0x7f) % kMaxCount;
   const int triangles = 1 + in.byte() % kMaxCount;
-  if (!in.has(static_cast<std::size_t>(vertices) * 3 * (raw ? sizeof(double) : 1) + 3 * static_cast<std::size_t>(triangles)))
+  if (!in.has(static_cast<std::size_t>(vertices) * 3 * (raw ? sizeof(double) : 1) +
+              3 * static_cast<std::size_t>(triangles)))
     return false;
   for (int v = 0; v < vertices; ++v) {
     Eigen::Vector3d& p = surface.points.emplace_back();

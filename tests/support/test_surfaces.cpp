@@ -21,8 +21,7 @@ using Eigen::Vector3d;
 using std::numbers::pi;
 
 // Image of a (nu x nv)-cell grid of [0,1]^2 under `map`; normals along d(map)/du x d(map)/dv.
-TriangleSurface parametric_patch(const std::function<Vector3d(double, double)>& map, int nu, int nv,
-                                 std::string name) {
+TriangleSurface parametric_patch(const std::function<Vector3d(double, double)>& map, int nu, int nv, std::string name) {
   TriangleSurface surface;
   surface.name = std::move(name);
   for (int j = 0; j <= nv; ++j) {
@@ -48,9 +47,9 @@ TriangleSurface graph_patch(const std::function<double(double, double)>& f, std:
                             std::array<double, 2> y_range, int n, std::string name) {
   return parametric_patch(
       [&](double u, double v) {
-        const double x = x_range[0] + u * (x_range[1] - x_range[0]);
-        const double y = y_range[0] + v * (y_range[1] - y_range[0]);
-        return Vector3d(x, y, f(x, y));
+    const double x = x_range[0] + u * (x_range[1] - x_range[0]);
+    const double y = y_range[0] + v * (y_range[1] - y_range[0]);
+    return Vector3d(x, y, f(x, y));
       },
       n, n, std::move(name));
 }
@@ -64,16 +63,16 @@ TriangleSurface near_vertical_patch(int n) {
   // Slope of x against y and z at most 0.04 + 0.008 pi / 0.6 < tan 5 degrees.
   return parametric_patch(
       [](double u, double v) {
-        const double y = 0.2 + 0.6 * u;
-        const double z = 0.2 + 0.6 * v;
-        return Vector3d(0.5 + 0.04 * (z - 0.5) + 0.008 * std::sin(pi * u) * std::sin(pi * v), y, z);
+    const double y = 0.2 + 0.6 * u;
+    const double z = 0.2 + 0.6 * v;
+    return Vector3d(0.5 + 0.04 * (z - 0.5) + 0.008 * std::sin(pi * u) * std::sin(pi * v), y, z);
       },
       n, n, "near_vertical");
 }
 
 TriangleSurface saddle(int n) {
-  return graph_patch([](double x, double y) { return 0.5 + 1.2 * (x - 0.5) * (y - 0.5); }, {0.1, 0.9},
-                     {0.1, 0.9}, n, "saddle");
+  return graph_patch([](double x, double y) { return 0.5 + 1.2 * (x - 0.5) * (y - 0.5); }, {0.1, 0.9}, {0.1, 0.9}, n,
+                     "saddle");
 }
 
 TriangleSurface spherical_cap(int n) {
@@ -122,8 +121,8 @@ TriangleSurface strongly_curved_sheet(int n) {
   const double span = 220.0 * pi / 180.0;
   return parametric_patch(
       [=](double u, double v) {
-        const double theta = start + span * u;
-        return Vector3d(0.5 + 0.3 * std::cos(theta), 0.2 + 0.6 * v, 0.5 + 0.3 * std::sin(theta));
+    const double theta = start + span * u;
+    return Vector3d(0.5 + 0.3 * std::cos(theta), 0.2 + 0.6 * v, 0.5 + 0.3 * std::sin(theta));
       },
       2 * n, n, "strongly_curved_sheet");
 }
@@ -141,9 +140,9 @@ std::vector<TriangleSurface> stacked_pair(int n) {
 TriangleSurface paper_like_patch(int n) {
   return graph_patch(
       [](double x, double y) {
-        const double u = (x - 0.2) / 0.6;
-        const double v = (y - 0.2) / 0.6;
-        return 0.42 + 0.12 * u * v + 0.10 * std::sin(pi * u) * std::sin(pi * v);
+    const double u = (x - 0.2) / 0.6;
+    const double v = (y - 0.2) / 0.6;
+    return 0.42 + 0.12 * u * v + 0.10 * std::sin(pi * u) * std::sin(pi * v);
       },
       {0.2, 0.8}, {0.2, 0.8}, n, "paper_like");
 }

@@ -22,11 +22,11 @@ namespace meccano::testing {
 TriangleSurface graph_patch(const std::function<double(double, double)>& f, std::array<double, 2> x_range,
                             std::array<double, 2> y_range, int n, std::string name = "graph");
 
-TriangleSurface tilted_plane(int n);           // z = 0.35 + 0.3 x + 0.1 y over [0.1, 0.9]^2
-TriangleSurface near_vertical_patch(int n);    // x ~ 0.5 + small bump, within 5 degrees of the plane x = 0.5
-TriangleSurface saddle(int n);                 // z = 0.5 + 1.2 (x - 0.5)(y - 0.5) over [0.1, 0.9]^2
-TriangleSurface spherical_cap(int n);          // radius 0.4, polar angle 65 degrees, circular rim, n rings
-TriangleSurface strongly_curved_sheet(int n);  // 220-degree sector of a cylinder of radius 0.3 (axis y)
+TriangleSurface tilted_plane(int n);               // z = 0.35 + 0.3 x + 0.1 y over [0.1, 0.9]^2
+TriangleSurface near_vertical_patch(int n);        // x ~ 0.5 + small bump, within 5 degrees of the plane x = 0.5
+TriangleSurface saddle(int n);                     // z = 0.5 + 1.2 (x - 0.5)(y - 0.5) over [0.1, 0.9]^2
+TriangleSurface spherical_cap(int n);              // radius 0.4, polar angle 65 degrees, circular rim, n rings
+TriangleSurface strongly_curved_sheet(int n);      // 220-degree sector of a cylinder of radius 0.3 (axis y)
 std::vector<TriangleSurface> stacked_pair(int n);  // two parallel bumps, 0.3 apart in z
 // The paper-like patch of shared/notes/peers.md section 6: over (x, y) in [0.2, 0.8]^2,
 // z = 0.42 + 0.12 u v + 0.10 sin(pi u) sin(pi v), u = (x - 0.2) / 0.6, v = (y - 0.2) / 0.6.

@@ -63,8 +63,8 @@ class MshFaces {
       if (count == tets_of_face_.end() || count->second != tets_per_face)
         throw InputError(file_.source + ": triangle " + std::to_string(file_.triangle_tags[e]) + " of " + group.name +
                          (count == tets_of_face_.end() ? " is not a face of any tetrahedron"
-                          : tets_per_face == 2     ? " is on the boundary: an interface must be made of interior faces"
-                                                   : " is an interior face: a box side must be on the boundary"));
+                          : tets_per_face == 2 ? " is on the boundary: an interface must be made of interior faces"
+                                               : " is an interior face: a box side must be on the boundary"));
       triangles.push_back(triangle);
     }
     return triangles;
@@ -183,12 +183,12 @@ void create_triangulation(const DealiiMesh& mesh, dealii::Triangulation<3>& tria
 }
 
 dealii::TriangulationDescription::Description<3, 3> fullydistributed_description(const DealiiMesh& mesh,
-                                                                                MPI_Comm communicator) {
+                                                                                 MPI_Comm communicator) {
   const unsigned int ranks = dealii::Utilities::MPI::n_mpi_processes(communicator);
   return dealii::TriangulationDescription::Utilities::create_description_from_triangulation_in_groups<3, 3>(
       [&mesh](dealii::Triangulation<3>& serial) { create_triangulation(mesh, serial); },
       [](dealii::Triangulation<3>& serial, const MPI_Comm&, const unsigned int group_size) {
-        dealii::GridTools::partition_triangulation(group_size, serial);  // one group of all ranks: a part per rank
+    dealii::GridTools::partition_triangulation(group_size, serial);  // one group of all ranks: a part per rank
       },
       communicator, static_cast<int>(ranks));
 }

@@ -144,8 +144,7 @@ double squared_distance_to_segment(const Vector3d& x, const Vector3d& p0, const 
   return (p0 + t * d - x).squaredNorm();
 }
 
-double squared_segment_distance(const Vector3d& p0, const Vector3d& p1, const Vector3d& q0,
-                                const Vector3d& q1) {
+double squared_segment_distance(const Vector3d& p0, const Vector3d& p1, const Vector3d& q0, const Vector3d& q1) {
   // The minimum is at an endpoint of one segment, or at the interior critical point of both.
   double best = std::min({squared_distance_to_segment(p0, q0, q1), squared_distance_to_segment(p1, q0, q1),
                           squared_distance_to_segment(q0, p0, p1), squared_distance_to_segment(q1, p0, p1)});
@@ -243,12 +242,9 @@ bool triangles_intersect(const Triangle3& a, const Triangle3& b, int shared_corn
       return unit_triangle_separation({points[0], points[1], points[2]}, {points[3], points[4], points[5]}) <=
              relative_tolerance;
     }
-    case 1:
-      return meet_beyond_shared_vertex(a, b);
-    case 2:
-      return fold_onto_shared_edge(a, b);
-    default:
-      throw std::invalid_argument("triangles_intersect: shared_corners must be 0, 1 or 2");
+    case 1: return meet_beyond_shared_vertex(a, b);
+    case 2: return fold_onto_shared_edge(a, b);
+    default: throw std::invalid_argument("triangles_intersect: shared_corners must be 0, 1 or 2");
   }
 }
 
@@ -394,7 +390,8 @@ double surface_distance(const TriangleSurface& a, const TriangleBVH& b) {
     box.extend(triangle[1]).extend(triangle[2]);
     box.min().array() -= best;
     box.max().array() += best;
-    b.for_each_triangle_overlapping(box, [&](int t) { best = std::min(best, triangle_distance(triangle, b.triangle(t))); });
+    b.for_each_triangle_overlapping(box,
+                                    [&](int t) { best = std::min(best, triangle_distance(triangle, b.triangle(t))); });
   }
   return best;
 }

@@ -1,7 +1,7 @@
 #include <meccano/inspect/mesh_file_check.hpp>
 
-#include <meccano/report/json_writer.hpp>
 #include <meccano/mesh/quality.hpp>
+#include <meccano/report/json_writer.hpp>
 
 #include "geometry/compensated_sum.hpp"
 #include "mesh/topology_helpers.hpp"
@@ -35,8 +35,8 @@ class MeshFileChecker {
   }
 
   MeshFileCheck run() {
-    MeshFileCheck report{mesh_.source, static_cast<std::int64_t>(mesh_.points.size()),
-                         static_cast<std::int64_t>(mesh_.tets.size()), {}};
+    MeshFileCheck report{
+        mesh_.source, static_cast<std::int64_t>(mesh_.points.size()), static_cast<std::int64_t>(mesh_.tets.size()), {}};
     report.checks.push_back(conformity());
     report.checks.push_back(orientation());
     report.checks.push_back(volume());
@@ -194,8 +194,8 @@ class MeshFileChecker {
     });
     for (const Face& face : side_faces)
       if (tets_with(face).size() != 1) problem(check, face_name(face), " of a box-side group is not a boundary face");
-    check.summary = std::to_string(side_faces.size()) + " box-side triangles, " + std::to_string(boundary) +
-                    " boundary faces";
+    check.summary =
+        std::to_string(side_faces.size()) + " box-side triangles, " + std::to_string(boundary) + " boundary faces";
     return check;
   }
 
@@ -231,9 +231,11 @@ class MeshFileChecker {
     // Not a defect of the mesh, but a fault solver that splits the interface's nodes needs a node off the
     // interface in every tet: counted, not failed (a coarse mesh that keeps the surface may have some).
     const auto on_interface = [&](int node) { return std::ranges::binary_search(vertices, node); };
-    const auto lying_on = std::ranges::count_if(mesh_.tets, [&](const std::array<int, 4>& tet) { return std::ranges::all_of(tet, on_interface); });
+    const auto lying_on = std::ranges::count_if(
+        mesh_.tets, [&](const std::array<int, 4>& tet) { return std::ranges::all_of(tet, on_interface); });
     check.summary = std::to_string(triangles.size()) + " triangles, Euler characteristic " +
-                    std::to_string(topology.euler()) + ", " + std::to_string(topology.boundary_loops) + " boundary loop(s)";
+                    std::to_string(topology.euler()) + ", " + std::to_string(topology.boundary_loops) +
+                    " boundary loop(s)";
     if (lying_on > 0) check.summary += ", " + std::to_string(lying_on) + " tets with all four nodes on it";
     return check;
   }

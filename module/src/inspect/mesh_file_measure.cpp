@@ -100,12 +100,14 @@ std::vector<const TriangleSurface*> match_surfaces(const MshMesh& mesh, std::spa
     if (is_interface(group)) interface_names += (interface_names.empty() ? "" : ", ") + group.name;
   for (const TriangleSurface& surface : surfaces) {
     const std::string name = "interface_" + surface.name;
-    const auto group = std::ranges::find_if(mesh.groups, [&](const MshGroup& g) { return is_interface(g) && g.name == name; });
+    const auto group =
+        std::ranges::find_if(mesh.groups, [&](const MshGroup& g) { return is_interface(g) && g.name == name; });
     if (group == mesh.groups.end())
       throw InputError(surface_label(surface) + ": " + mesh.source + " has no 2D group " + name +
                        " (its interface groups: " + (interface_names.empty() ? "none" : interface_names) + ")");
     const TriangleSurface*& slot = matched[group - mesh.groups.begin()];
-    if (slot) throw InputError(surface_label(surface) + " and " + surface_label(*slot) + " are both named " + surface.name);
+    if (slot)
+      throw InputError(surface_label(surface) + " and " + surface_label(*slot) + " are both named " + surface.name);
     if (surface.triangles.empty()) throw InputError(surface_label(surface) + " has no triangles");
     if (group->elements.empty())
       throw InputError(mesh.source + ": group " + name + " has no triangles to compare with " + surface_label(surface));
@@ -175,10 +177,10 @@ std::string MeshMeasure::text() const {
     out << i.name << ": " << i.faces << " faces, area " << i.area << '\n';
     if (!i.accuracy) continue;
     const SurfaceAccuracy& a = *i.accuracy;
-    out << "  against " << a.surface << ": node distance max " << a.node_distance_max << ", mean " << a.node_distance_mean
-        << "; Hausdorff " << a.hausdorff << "; normal deviation max " << a.normal_deviation_max_deg << ", mean "
-        << a.normal_deviation_mean_deg << " deg; " << a.flipped_faces << " flipped faces; area ratio " << a.area_ratio
-        << '\n';
+    out << "  against " << a.surface << ": node distance max " << a.node_distance_max << ", mean "
+        << a.node_distance_mean << "; Hausdorff " << a.hausdorff << "; normal deviation max "
+        << a.normal_deviation_max_deg << ", mean " << a.normal_deviation_mean_deg << " deg; " << a.flipped_faces
+        << " flipped faces; area ratio " << a.area_ratio << '\n';
   }
   return out.str();
 }
@@ -196,7 +198,12 @@ std::string MeshMeasure::json() const {
     if (i.accuracy) {
       const SurfaceAccuracy& a = *i.accuracy;
       json.key("surface").value(a.surface);
-      json.key("node_distance").begin_object().key("max").value(a.node_distance_max).key("mean").value(a.node_distance_mean);
+      json.key("node_distance")
+          .begin_object()
+          .key("max")
+          .value(a.node_distance_max)
+          .key("mean")
+          .value(a.node_distance_mean);
       json.end_object().key("hausdorff").value(a.hausdorff);
       json.key("normal_deviation_deg").begin_object().key("max").value(a.normal_deviation_max_deg);
       json.key("mean").value(a.normal_deviation_mean_deg).end_object();

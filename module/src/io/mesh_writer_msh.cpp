@@ -3,8 +3,8 @@
 
 #include "io/writer_helpers.hpp"
 
-#include <meccano/io/atomic_file.hpp>
 #include <meccano/error.hpp>
+#include <meccano/io/atomic_file.hpp>
 
 #include <algorithm>
 #include <map>
@@ -57,8 +57,10 @@ Partition partition_by_membership(std::int64_t key_count, const std::vector<std:
 // The same in both versions: the groups' own tags.
 void write_physical_names(TextWriter& out, const MeshGroups& groups) {
   out << "$PhysicalNames\n" << static_cast<int>(groups.volumes.size() + groups.surfaces.size()) << '\n';
-  for (const TetGroup& group : groups.volumes) out << "3 " << group.tag << " \"" << std::string_view(group.name) << "\"\n";
-  for (const FaceGroup& group : groups.surfaces) out << "2 " << group.tag << " \"" << std::string_view(group.name) << "\"\n";
+  for (const TetGroup& group : groups.volumes)
+    out << "3 " << group.tag << " \"" << std::string_view(group.name) << "\"\n";
+  for (const FaceGroup& group : groups.surfaces)
+    out << "2 " << group.tag << " \"" << std::string_view(group.name) << "\"\n";
   out << "$EndPhysicalNames\n";
 }
 
@@ -84,8 +86,8 @@ void write_msh41(const TetMesh& mesh, const MeshGroups& groups, const std::strin
 
     const Box& box = mesh.meccano.box;
     auto bounding_box = [&] {
-      out << box.min.x() << ' ' << box.min.y() << ' ' << box.min.z() << ' ' << box.max.x() << ' '
-          << box.max.y() << ' ' << box.max.z();
+      out << box.min.x() << ' ' << box.min.y() << ' ' << box.min.z() << ' ' << box.max.x() << ' ' << box.max.y() << ' '
+          << box.max.z();
     };
     auto physical_tags = [&](const std::vector<int>& member_of, const auto& same_dimension) {
       out << ' ' << static_cast<int>(member_of.size());
@@ -118,18 +120,20 @@ void write_msh41(const TetMesh& mesh, const MeshGroups& groups, const std::strin
     for (const auto& items : surfaces.entity_items) element_count += static_cast<std::int64_t>(items.size());
     for (const auto& items : volumes.entity_items) element_count += static_cast<std::int64_t>(items.size());
     out << "$Elements\n"
-        << static_cast<int>(surfaces.entity_items.size() + volumes.entity_items.size()) << ' ' << element_count
-        << " 1 " << element_count << '\n';
+        << static_cast<int>(surfaces.entity_items.size() + volumes.entity_items.size()) << ' ' << element_count << " 1 "
+        << element_count << '\n';
     std::int64_t tag = 0;
     for (std::size_t e = 0; e < surfaces.entity_items.size(); ++e) {
-      out << "2 " << static_cast<int>(e + 1) << " 2 " << static_cast<std::int64_t>(surfaces.entity_items[e].size()) << '\n';
+      out << "2 " << static_cast<int>(e + 1) << " 2 " << static_cast<std::int64_t>(surfaces.entity_items[e].size())
+          << '\n';
       for (std::int64_t key : surfaces.entity_items[e]) {
         const auto face = mesh.outward_face(static_cast<TetId>(key / 4), static_cast<int>(key % 4));
         out << ++tag << ' ' << face[0] + 1 << ' ' << face[1] + 1 << ' ' << face[2] + 1 << '\n';
       }
     }
     for (std::size_t e = 0; e < volumes.entity_items.size(); ++e) {
-      out << "3 " << static_cast<int>(e + 1) << " 4 " << static_cast<std::int64_t>(volumes.entity_items[e].size()) << '\n';
+      out << "3 " << static_cast<int>(e + 1) << " 4 " << static_cast<std::int64_t>(volumes.entity_items[e].size())
+          << '\n';
       for (std::int64_t t : volumes.entity_items[e]) {
         const auto v = mesh.oriented_tet(static_cast<TetId>(t));
         out << ++tag << ' ' << v[0] + 1 << ' ' << v[1] + 1 << ' ' << v[2] + 1 << ' ' << v[3] + 1 << '\n';

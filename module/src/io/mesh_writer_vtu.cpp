@@ -89,14 +89,10 @@ void write_data_array(std::ostream& out, std::string_view attributes, std::int64
 std::string xml_escaped(std::string_view text) {
   std::string escaped;
   for (const char c : text) {
-    if (c == '&')
-      escaped += "&amp;";
-    else if (c == '<')
-      escaped += "&lt;";
-    else if (c == '>')
-      escaped += "&gt;";
-    else
-      escaped += c;
+    if (c == '&') escaped += "&amp;";
+    else if (c == '<') escaped += "&lt;";
+    else if (c == '>') escaped += "&gt;";
+    else escaped += c;
   }
   return escaped;
 }
@@ -134,12 +130,12 @@ void write_vtu(const TetMesh& mesh, const MeshGroups& groups, const std::string&
         << "\">\n<Points>\n";
     write_data_array<double>(out, "Name=\"Points\" NumberOfComponents=\"3\"", 3 * std::int64_t{mesh.num_vertices()},
                              [&](auto put) {
-                               for (const auto& p : mesh.points) {
-                                 put(p.x());
-                                 put(p.y());
-                                 put(p.z());
-                               }
-                             });
+      for (const auto& p : mesh.points) {
+        put(p.x());
+        put(p.y());
+        put(p.z());
+      }
+    });
 
     out << "</Points>\n<Cells>\n";
     // Cell-wise arrays: tets value, triangles value, or per element of the traversal.
@@ -165,9 +161,8 @@ void write_vtu(const TetMesh& mesh, const MeshGroups& groups, const std::string&
                                    per_cell([](int, TetId) { return vtk_tetra; }, [](int) { return vtk_triangle; }));
 
     out << "</Cells>\n<CellData Scalars=\"group\">\n";
-    write_data_array<std::int32_t>(
-        out, "Name=\"group\"", tets + triangles,
-        per_cell([](int tag, TetId) { return tag; }, [](int tag) { return tag; }));
+    write_data_array<std::int32_t>(out, "Name=\"group\"", tets + triangles,
+                                   per_cell([](int tag, TetId) { return tag; }, [](int tag) { return tag; }));
     write_data_array<double>(
         out, "Name=\"quality_meccano\"", tets + triangles,
         per_cell([&](int, TetId t) { return meccano_quality[t]; }, [](int) { return triangle_quality; }));

@@ -30,7 +30,8 @@ void check_groups(const TetMesh& mesh, const MeshGroups& groups) {
     std::set<int> tags;
     for (const auto& group : same_dimension) {
       if (group.tag < 1)
-        throw std::invalid_argument("mesh group " + group.name + ": tag " + std::to_string(group.tag) + " is not positive");
+        throw std::invalid_argument("mesh group " + group.name + ": tag " + std::to_string(group.tag) +
+                                    " is not positive");
       if (!tags.insert(group.tag).second)
         throw std::invalid_argument("mesh group " + group.name + ": tag " + std::to_string(group.tag) +
                                     " is already the tag of another " + dimension + " group");
@@ -90,9 +91,8 @@ MeshGroups standard_groups(const TetMesh& mesh, const std::vector<std::string>& 
         if (other != no_tet && other < t) continue;  // written once, from the first tet
         const int index = interface_index(tag);
         auto& group = interfaces[index];
-        group.name = "interface_" + (index < static_cast<int>(interface_names.size())
-                                         ? interface_names[index]
-                                         : std::to_string(index + 1));
+        group.name = "interface_" + (index < static_cast<int>(interface_names.size()) ? interface_names[index]
+                                                                                      : std::to_string(index + 1));
         group.tag = tag;
         group.faces.push_back({t, f});
       }
@@ -122,17 +122,11 @@ void write_mesh(const TetMesh& mesh, const MeshGroups& groups, const std::string
     throw InputError("cannot write " + path + ": unknown mesh format (the extensions are .msh, .vtu and .mesh)");
   switch (*format) {
     case MeshFormat::msh:
-      if (options.msh_version == MshVersion::v22)
-        write_msh22(mesh, groups, path);
-      else
-        write_msh41(mesh, groups, path);
+      if (options.msh_version == MshVersion::v22) write_msh22(mesh, groups, path);
+      else write_msh41(mesh, groups, path);
       return;
-    case MeshFormat::vtu:
-      write_vtu(mesh, groups, path);
-      return;
-    case MeshFormat::medit:
-      write_medit(mesh, groups, path);
-      return;
+    case MeshFormat::vtu: write_vtu(mesh, groups, path); return;
+    case MeshFormat::medit: write_medit(mesh, groups, path); return;
   }
 }
 

@@ -161,7 +161,8 @@ TriangleSurface parse_obj(const std::string& path, std::string_view bytes, ReadC
   while (const std::optional<Token> keyword = cursor.next_token()) {
     if (keyword->text == "v") {
       Eigen::Vector3d p;
-      for (int axis = 0; axis < 3; ++axis) p[axis] = cursor.coordinate(cursor.expect_token_on_line("vertex coordinate"));
+      for (int axis = 0; axis < 3; ++axis)
+        p[axis] = cursor.coordinate(cursor.expect_token_on_line("vertex coordinate"));
       points.push_back(p);
     } else if (keyword->text == "f") {
       polygon.clear();
@@ -226,7 +227,8 @@ TriangleSurface parse_binary_stl(const std::string& path, std::string_view bytes
   const std::uint64_t expected = kStlHeaderBytes + kStlRecordBytes * count;
   if (expected != bytes.size())
     fail_file(path, "binary STL header announces " + std::to_string(count) + " triangles, which need " +
-                        std::to_string(expected) + " bytes, but the file has " + std::to_string(bytes.size()) + " bytes" +
+                        std::to_string(expected) + " bytes, but the file has " + std::to_string(bytes.size()) +
+                        " bytes" +
                         (expected > bytes.size() ? " (truncated file or corrupt triangle count)"
                                                  : " (unexpected data after the last triangle)"));
   if (count > std::numeric_limits<int>::max() / 3)
@@ -266,8 +268,8 @@ TriangleSurface parse_ascii_stl(const std::string& path, std::string_view bytes,
       if (!next) break;
       // Some exporters write one solid per part into the same file.
       if (!iequals(next->text, "solid"))
-        cursor.fail_at(next->line, "expected 'solid' or the end of the file after 'endsolid', found " +
-                                       quoted(next->text));
+        cursor.fail_at(next->line,
+                       "expected 'solid' or the end of the file after 'endsolid', found " + quoted(next->text));
       cursor.skip_line();
       continue;
     }
@@ -295,8 +297,8 @@ TriangleSurface parse_ascii_stl(const std::string& path, std::string_view bytes,
 }
 
 TriangleSurface parse_stl(const std::string& path, std::string_view bytes, ReadContext& context) {
-  const bool binary_size = bytes.size() >= kStlHeaderBytes &&
-                           bytes.size() == kStlHeaderBytes + kStlRecordBytes * binary_stl_count(bytes);
+  const bool binary_size =
+      bytes.size() >= kStlHeaderBytes && bytes.size() == kStlHeaderBytes + kStlRecordBytes * binary_stl_count(bytes);
   if (!binary_size && looks_like_text(bytes)) {
     if (!starts_with_solid(bytes)) fail_file(path, "not an STL file: text that does not start with 'solid'");
     return parse_ascii_stl(path, bytes, context);
@@ -430,10 +432,19 @@ constexpr double kTsurfRelativeWeldTolerance = 1e-6;  // times the bounding-box 
 
 // Metres in one AXIS_UNIT of a GOCAD coordinate system (quoted or not); 0 when the unit is unknown.
 double metres_per_unit(std::string_view unit) {
-  constexpr std::array<std::pair<std::string_view, double>, 13> kUnits{{
-      {"m", 1.0}, {"meter", 1.0}, {"meters", 1.0}, {"metre", 1.0}, {"metres", 1.0},
-      {"km", 1000.0}, {"kilometer", 1000.0}, {"kilometers", 1000.0}, {"kilometre", 1000.0}, {"kilometres", 1000.0},
-      {"ft", 0.3048}, {"foot", 0.3048}, {"feet", 0.3048}}};
+  constexpr std::array<std::pair<std::string_view, double>, 13> kUnits{{{"m", 1.0},
+                                                                        {"meter", 1.0},
+                                                                        {"meters", 1.0},
+                                                                        {"metre", 1.0},
+                                                                        {"metres", 1.0},
+                                                                        {"km", 1000.0},
+                                                                        {"kilometer", 1000.0},
+                                                                        {"kilometers", 1000.0},
+                                                                        {"kilometre", 1000.0},
+                                                                        {"kilometres", 1000.0},
+                                                                        {"ft", 0.3048},
+                                                                        {"foot", 0.3048},
+                                                                        {"feet", 0.3048}}};
   if (unit.size() >= 2 && unit.front() == '"' && unit.back() == '"') unit = unit.substr(1, unit.size() - 2);
   for (const auto& [name, metres] : kUnits)
     if (iequals(unit, name)) return metres;
@@ -468,10 +479,8 @@ class TsurfReader {
   TsurfFile read(ReadContext& context) {
     start_object(cursor_.expect_token("'GOCAD TSurf' header"));
     while (const std::optional<Token> keyword = cursor_.next_token()) {
-      if (object_line_ == 0)
-        start_object(*keyword);
-      else
-        read_keyword(*keyword);
+      if (object_line_ == 0) start_object(*keyword);
+      else read_keyword(*keyword);
     }
     if (object_line_ != 0)
       cursor_.fail_at_end("'END' of the object that starts at line " + std::to_string(object_line_));
@@ -491,8 +500,8 @@ class TsurfReader {
   void start_object(const Token& gocad) {
     if (!iequals(gocad.text, "GOCAD")) {
       if (file_.objects.empty())
-        cursor_.fail_at(gocad.line, "not a GOCAD TSurf file: it starts with " + quoted(gocad.text) +
-                                        " instead of 'GOCAD TSurf'");
+        cursor_.fail_at(gocad.line,
+                        "not a GOCAD TSurf file: it starts with " + quoted(gocad.text) + " instead of 'GOCAD TSurf'");
       cursor_.fail_at(gocad.line, "expected 'GOCAD TSurf' (another object) or the end of the file after END, found " +
                                       quoted(gocad.text));
     }

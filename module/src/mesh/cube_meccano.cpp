@@ -1,7 +1,7 @@
 #include <meccano/mesh/cube_meccano.hpp>
 
-#include <meccano/mesh/bisection.hpp>
 #include <meccano/error.hpp>
+#include <meccano/mesh/bisection.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -23,9 +23,8 @@ void tag_box_sides(TetMesh& mesh) {
       for (int axis = 0; axis < 3; ++axis)
         for (int upper_side = 0; upper_side < 2; ++upper_side) {
           const std::int64_t plane = upper_side ? upper[axis] : 0;
-          const bool on_plane = std::all_of(face_vertices[f].begin(), face_vertices[f].end(), [&](int local) {
-            return mesh.grid[mesh.tets[t][local]][axis] == plane;
-          });
+          const bool on_plane = std::all_of(face_vertices[f].begin(), face_vertices[f].end(),
+                                            [&](int local) { return mesh.grid[mesh.tets[t][local]][axis] == plane; });
           if (on_plane) mesh.face_tags[t][f] = box_side_tag(static_cast<BoxSide>(2 * axis + upper_side));
         }
     }
@@ -37,7 +36,8 @@ std::string box_defect(const Box& box) {
   for (int k = 0; k < 3; ++k)
     if (!(box.min[k] < box.max[k]) || !std::isfinite(box.max[k] - box.min[k])) {
       std::ostringstream defect;
-      defect << "on axis " << "xyz"[k] << " the minimum " << box.min[k] << " must be below the maximum " << box.max[k];
+      defect << "on axis "
+             << "xyz"[k] << " the minimum " << box.min[k] << " must be below the maximum " << box.max[k];
       if (box.min[k] < box.max[k]) defect << " by a finite extent";
       return defect.str();
     }
@@ -68,8 +68,8 @@ TetMesh make_cube_meccano(const Box& box, const std::array<int, 3>& cells, int l
   check_box(box);
   for (int k = 0; k < 3; ++k)
     if (cells[k] < 1 || cells[k] > max_cells_per_axis)
-      throw InputError("invalid cell count " + std::to_string(cells[k]) + " on axis " + "xyz"[k] +
-                       " (allowed: 1 to " + std::to_string(max_cells_per_axis) + ")");
+      throw InputError("invalid cell count " + std::to_string(cells[k]) + " on axis " + "xyz"[k] + " (allowed: 1 to " +
+                       std::to_string(max_cells_per_axis) + ")");
   if (level < 0) throw InputError("invalid level " + std::to_string(level) + " (must be 0 or more)");
 
   TetMesh mesh;
@@ -123,7 +123,8 @@ double longest_edge_at_level(const MeccanoGrid& meccano, int level) {
 }
 
 int level_for_resolution(const MeccanoGrid& meccano, double resolution) {
-  if (!(resolution > 0.0)) throw InputError("the resolution l_r must be positive (got " + std::to_string(resolution) + ")");
+  if (!(resolution > 0.0))
+    throw InputError("the resolution l_r must be positive (got " + std::to_string(resolution) + ")");
   // Each three levels halve the edges; start near the answer and step to it.
   const double diagonal = meccano.cell_size.norm();
   int level = std::max(0, 3 * static_cast<int>(std::floor(std::log2(diagonal / resolution))) - 3);

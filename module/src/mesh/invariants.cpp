@@ -58,7 +58,8 @@ class Checker {
         problem("tet ", t, " has orientation ", sign, " but records the opposite");
       if (options_.physical) {
         const auto o = mesh_.oriented_tet(t);
-        const double volume = signed_volume(mesh_.points[o[0]], mesh_.points[o[1]], mesh_.points[o[2]], mesh_.points[o[3]]);
+        const double volume =
+            signed_volume(mesh_.points[o[0]], mesh_.points[o[1]], mesh_.points[o[2]], mesh_.points[o[3]]);
         physical_volume_.add(volume);
         if (!(volume > 0.0)) {
           ++report_.inverted_physical;

@@ -115,7 +115,8 @@ TetPoints oriented_computational_points(const TetMesh& mesh, TetId t) {
 
 double mean_ratio_meccano(const TetMesh& mesh, TetId t) {
   const TetPoints p = oriented_points(mesh, t);
-  return mesh.bisectable(t) ? mean_ratio_relative(p, oriented_computational_points(mesh, t)) : mean_ratio_equilateral(p);
+  return mesh.bisectable(t) ? mean_ratio_relative(p, oriented_computational_points(mesh, t))
+                            : mean_ratio_equilateral(p);
 }
 
 void QualityAccumulator::Moments::merge(const Moments& other) {
@@ -127,8 +128,8 @@ void QualityAccumulator::Moments::merge(const Moments& other) {
   const auto total = static_cast<double>(count + other.count);
   const double delta = other.mean - mean;
   mean += delta * static_cast<double>(other.count) / total;
-  squared_deviations += other.squared_deviations +
-                        delta * delta * static_cast<double>(count) * static_cast<double>(other.count) / total;
+  squared_deviations +=
+      other.squared_deviations + delta * delta * static_cast<double>(count) * static_cast<double>(other.count) / total;
   min = std::min(min, other.min);
   count += other.count;
 }
@@ -225,13 +226,13 @@ QualitySummary summarize_quality(const TetMesh& mesh, int histogram_bins) {
   return summarize_tet_quality(
       mesh.num_tets(),
       [&](std::int64_t t, QualityAccumulator& quality) {
-        const auto tet = static_cast<TetId>(t);
-        if (mesh.bisectable(tet)) {
-          const TetPoints computational = oriented_computational_points(mesh, tet);
-          quality.add(oriented_points(mesh, tet), &computational);
-        } else {
-          quality.add(oriented_points(mesh, tet));
-        }
+    const auto tet = static_cast<TetId>(t);
+    if (mesh.bisectable(tet)) {
+      const TetPoints computational = oriented_computational_points(mesh, tet);
+      quality.add(oriented_points(mesh, tet), &computational);
+    } else {
+      quality.add(oriented_points(mesh, tet));
+    }
       },
       histogram_bins);
 }

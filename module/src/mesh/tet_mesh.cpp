@@ -172,9 +172,8 @@ void build_neighbours(TetMesh& mesh) {
     std::size_t j = i + 1;
     while (j < faces.size() && faces[j].key == faces[i].key) ++j;
     if (j - i > 2)
-      throw MeshingError("face (" + std::to_string(faces[i].key[0]) + ", " + std::to_string(faces[i].key[1]) +
-                         ", " + std::to_string(faces[i].key[2]) + ") is shared by " + std::to_string(j - i) +
-                         " tets");
+      throw MeshingError("face (" + std::to_string(faces[i].key[0]) + ", " + std::to_string(faces[i].key[1]) + ", " +
+                         std::to_string(faces[i].key[2]) + ") is shared by " + std::to_string(j - i) + " tets");
     if (j - i == 2) {
       mesh.neighbours[faces[i].tet][faces[i].local_face] = faces[i + 1].tet;
       mesh.neighbours[faces[i + 1].tet][faces[i + 1].local_face] = faces[i].tet;

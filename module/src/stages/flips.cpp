@@ -1,7 +1,7 @@
 // The topological half of the improvement stage: 2-3 flips and edge removal (stages/improvement.hpp).
 #include <meccano/error.hpp>
-#include <meccano/stages/improvement.hpp>
 #include <meccano/mesh/quality.hpp>
+#include <meccano/stages/improvement.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -71,7 +71,11 @@ class Flipper {
  public:
   Flipper(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, std::span<TetRegion* const> regions,
           const ImprovementOptions& options)
-      : mesh_(mesh), surfaces_(surfaces), regions_(regions), options_(options), surface_of_(mesh.points.size(), -1),
+      : mesh_(mesh),
+        surfaces_(surfaces),
+        regions_(regions),
+        options_(options),
+        surface_of_(mesh.points.size(), -1),
         node_index_(mesh.points.size(), -1) {
     for (std::size_t s = 0; s < surfaces.size(); ++s)
       for (std::size_t i = 0; i < surfaces[s]->nodes.size(); ++i) {
@@ -79,7 +83,8 @@ class Flipper {
         node_index_[surfaces[s]->nodes[i]] = static_cast<int>(i);
       }
     for (const TetRegion* region : regions)
-      if (region->size() != mesh.tets.size()) throw std::invalid_argument("flip_worst_tets: a region's size is not the tet count");
+      if (region->size() != mesh.tets.size())
+        throw std::invalid_argument("flip_worst_tets: a region's size is not the tet count");
   }
 
   // Mends S_M where a crease line of S crosses one of its edges between the edge's nodes
@@ -98,7 +103,8 @@ class Flipper {
       for (int pass = 0; pass < max_crease_passes; ++pass) {
         const SurfaceProjection& projection = *surfaces_[s];
         std::vector<int> touched;  // nodes of the edges mended in this pass: their other crossings wait
-        for (const CreaseCrossing& crossing : straddling_crossings(projection.creases, projection.triangles, projection.uv)) {
+        for (const CreaseCrossing& crossing :
+             straddling_crossings(projection.creases, projection.triangles, projection.uv)) {
           if (std::ranges::find(touched, crossing.a) != touched.end() ||
               std::ranges::find(touched, crossing.b) != touched.end() || !mend_crossing(s, crossing))
             continue;
@@ -146,7 +152,8 @@ class Flipper {
   // use such a tet).
   double new_tet_quality(const Tet& tet) const {
     const int surface = surface_of_[tet[0]];
-    if (surface >= 0 && surface_of_[tet[1]] == surface && surface_of_[tet[2]] == surface && surface_of_[tet[3]] == surface)
+    if (surface >= 0 && surface_of_[tet[1]] == surface && surface_of_[tet[2]] == surface &&
+        surface_of_[tet[3]] == surface)
       return unacceptable;
     return quality(tet);
   }
@@ -225,11 +232,12 @@ class Flipper {
     if (!(crossing.s > 1e-9 * line.length() && crossing.s < (1.0 - 1e-9) * line.length())) return false;
     const VertexId a = projection.nodes[crossing.a], b = projection.nodes[crossing.b];
     const std::vector<TetId> around_a = star_of(a);
-    const auto start = std::ranges::find_if(around_a, [&](TetId t) { return std::ranges::find(mesh_.tets[t], b) != mesh_.tets[t].end(); });
-    if (start == around_a.end()) throw MeshingError("an S_M edge of surface " + std::to_string(s) + " is not an edge of the mesh");
+    const auto start = std::ranges::find_if(
+        around_a, [&](TetId t) { return std::ranges::find(mesh_.tets[t], b) != mesh_.tets[t].end(); });
+    if (start == around_a.end())
+      throw MeshingError("an S_M edge of surface " + std::to_string(s) + " is not an edge of the mesh");
 
-    if (std::optional<Retriangulation> flip = edge_removal(*start, a, b, mend_floor_);
-        flip && flip->surface_flip) {
+    if (std::optional<Retriangulation> flip = edge_removal(*start, a, b, mend_floor_); flip && flip->surface_flip) {
       bool along = true;
       for (const auto& triangle : flip->surface_flip->created)
         for (int node : triangle)
@@ -267,8 +275,7 @@ class Flipper {
     const int vertices = mesh_.num_vertices();
     std::optional<Retriangulation> split = crease_split(s, crossing, point, *start);
     if (split && split->worst_created > best && acceptable(split->worst_created, split->worst_removed) &&
-        split_aligns(s, crossing, split->split_apexes) &&
-        apply(*split)) {
+        split_aligns(s, crossing, split->split_apexes) && apply(*split)) {
       add_split_node(s, crossing, split->split_apexes);
       return true;
     }
@@ -300,7 +307,8 @@ class Flipper {
   bool split_aligns(int s, const CreaseCrossing& crossing, std::span<const VertexId> apexes) const {
     const SurfaceProjection& projection = *surfaces_[s];
     const Eigen::Vector3d& m = mesh_.points.back();
-    const Eigen::Vector3d &xa = mesh_.points[projection.nodes[crossing.a]], &xb = mesh_.points[projection.nodes[crossing.b]];
+    const Eigen::Vector3d &xa = mesh_.points[projection.nodes[crossing.a]],
+                          &xb = mesh_.points[projection.nodes[crossing.b]];
     const Eigen::Vector2d &ua = projection.uv[crossing.a], &ub = projection.uv[crossing.b];
     double before = 1.0, after = 1.0;
     for (VertexId x : apexes) {
@@ -333,7 +341,8 @@ class Flipper {
   // caller keeps it with add_split_node or drops it), the tets around the edge halved through it, the
   // tagged faces around the edge halved with their tags. Nothing if a face around the edge lies on the
   // box or another surface.
-  std::optional<Retriangulation> crease_split(int s, const CreaseCrossing& crossing, const Eigen::Vector3d& point, TetId start) {
+  std::optional<Retriangulation> crease_split(int s, const CreaseCrossing& crossing, const Eigen::Vector3d& point,
+                                              TetId start) {
     const SurfaceProjection& projection = *surfaces_[s];
     const VertexId a = projection.nodes[crossing.a], b = projection.nodes[crossing.b];
 
@@ -420,13 +429,15 @@ class Flipper {
   std::vector<TetId> flag_parents(const Retriangulation& r, std::span<const BoundaryFace> boundary) const {
     std::vector<TetId> parents = r.flag_parent;
     auto same_flags = [&](TetId x, TetId y) {
-      return std::all_of(regions_.begin(), regions_.end(), [&](const TetRegion* region) { return (*region)[x] == (*region)[y]; });
+      return std::all_of(regions_.begin(), regions_.end(),
+                         [&](const TetRegion* region) { return (*region)[x] == (*region)[y]; });
     };
     for (std::size_t i = 0; i < r.created.size(); ++i) {
       bool on_interface = false;
       for (int f = 0; f < 4; ++f) {
         const auto key = sorted_face(r.created[i], f);
-        const auto face = std::find_if(boundary.begin(), boundary.end(), [&](const BoundaryFace& b) { return b.key == key; });
+        const auto face =
+            std::find_if(boundary.begin(), boundary.end(), [&](const BoundaryFace& b) { return b.key == key; });
         if (face == boundary.end() || !is_interface_tag(face->tag)) continue;
         if (on_interface && !same_flags(face->owner, parents[i])) return {};
         on_interface = true;
@@ -589,7 +600,8 @@ class Flipper {
       const FaceTag interface = around->interface;
       r.surface_flip = interface_flip(interface_index(interface), a, b, ring[0], ring[q]);
       if (!r.surface_flip) return std::nullopt;
-      r.tagged_faces = {{sorted_face({a, ring[0], ring[q], b}, 3), interface}, {sorted_face({b, ring[0], ring[q], a}, 3), interface}};
+      r.tagged_faces = {{sorted_face({a, ring[0], ring[q], b}, 3), interface},
+                        {sorted_face({b, ring[0], ring[q], a}, 3), interface}};
     }
     add_triangulated_tets(r, a, b, ring, polygons, triangulations.split);
     return r;
@@ -613,7 +625,8 @@ class Flipper {
     flip.removed = {sorted_triangle({na, nb, np}), sorted_triangle({na, nb, nq})};
     flip.created = {std::array<int, 3>{np, nq, na}, std::array<int, 3>{nq, np, nb}};
     for (auto& triangle : flip.created)
-      if ((orient(triangle[0], triangle[1], triangle[2]) > 0.0) != (projection.orientation > 0)) std::swap(triangle[1], triangle[2]);
+      if ((orient(triangle[0], triangle[1], triangle[2]) > 0.0) != (projection.orientation > 0))
+        std::swap(triangle[1], triangle[2]);
     return flip;
   }
 
@@ -622,7 +635,8 @@ class Flipper {
   double alignment(int s, const std::array<Eigen::Vector3d, 3>& x, const Eigen::Vector2d& at) const {
     const ParametricSurface& surface = *surfaces_[s]->surface;
     const Eigen::Matrix<double, 3, 2> tangent = surface.derivative(surface.locate(at).triangle);
-    return std::abs((x[1] - x[0]).cross(x[2] - x[0]).normalized().dot(tangent.col(0).cross(tangent.col(1)).normalized()));
+    return std::abs(
+        (x[1] - x[0]).cross(x[2] - x[0]).normalized().dot(tangent.col(0).cross(tangent.col(1)).normalized()));
   }
   // The alignment of S_M's triangle over surface s's nodes, at its centroid in P.
   double triangle_alignment(int s, const std::array<int, 3>& nodes) const {
@@ -674,8 +688,8 @@ class Flipper {
       for (int f = 0; f < 4; ++f) {
         const TetId n = mesh_.neighbours[t][f];
         if (std::find(removed.begin(), removed.end(), n) != removed.end()) continue;
-        boundary.push_back({sorted_face(mesh_.tets[t], f), t, n, n == no_tet ? -1 : mesh_.face_towards(n, t),
-                            mesh_.face_tags[t][f]});
+        boundary.push_back(
+            {sorted_face(mesh_.tets[t], f), t, n, n == no_tet ? -1 : mesh_.face_towards(n, t), mesh_.face_tags[t][f]});
       }
     return boundary;
   }
@@ -732,7 +746,8 @@ class Flipper {
         const auto key = sorted_face(r.created[i], f);
         TetId& neighbour = mesh_.neighbours[slots[i]][f];
         FaceTag& tag = mesh_.face_tags[slots[i]][f];
-        const auto outer = std::find_if(boundary.begin(), boundary.end(), [&](const BoundaryFace& b) { return b.key == key; });
+        const auto outer =
+            std::find_if(boundary.begin(), boundary.end(), [&](const BoundaryFace& b) { return b.key == key; });
         if (outer != boundary.end()) {
           neighbour = outer->neighbour;
           tag = outer->tag;
@@ -744,8 +759,10 @@ class Flipper {
         for (std::size_t k = 0; k < slots.size() && neighbour == no_tet; ++k)
           for (int g = 0; g < 4; ++g)
             if (k != i && sorted_face(r.created[k], g) == key) neighbour = slots[k];
-        if (neighbour == no_tet) throw MeshingError("a flip left a face of tet " + std::to_string(slots[i]) + " without a neighbour");
-        const auto tagged = std::find_if(r.tagged_faces.begin(), r.tagged_faces.end(), [&](const auto& face) { return face.first == key; });
+        if (neighbour == no_tet)
+          throw MeshingError("a flip left a face of tet " + std::to_string(slots[i]) + " without a neighbour");
+        const auto tagged = std::find_if(r.tagged_faces.begin(), r.tagged_faces.end(),
+                                         [&](const auto& face) { return face.first == key; });
         tag = tagged == r.tagged_faces.end() ? no_face_tag : tagged->second;
       }
     if (linked != boundary.size()) throw MeshingError("a flip changed the boundary of the tets it replaced");

@@ -124,17 +124,16 @@ Connectivity connect(DiskView disk) {
     }
   }
   if (rim_edges == 0) throw MeshingError("parameterization: the surface has no rim (it is closed)");
-  const int start = static_cast<int>(std::find_if(rim_next.begin(), rim_next.end(), [](int v) { return v >= 0; }) -
-                                     rim_next.begin());
+  const int start =
+      static_cast<int>(std::find_if(rim_next.begin(), rim_next.end(), [](int v) { return v >= 0; }) - rim_next.begin());
   c.rim_position.assign(n, -1);
   for (int v = start; v >= 0 && c.rim_position[v] < 0; v = rim_next[v]) {
     c.rim_position[v] = static_cast<int>(c.rim.size());
     c.rim.push_back(v);
   }
   if (static_cast<int>(c.rim.size()) != rim_edges || rim_next[c.rim.back()] != start)
-    throw MeshingError("parameterization: the rim is not one loop: the loop through vertex " + c.name(start) +
-                       " has " + std::to_string(c.rim.size()) + " of the " + std::to_string(rim_edges) +
-                       " rim edges");
+    throw MeshingError("parameterization: the rim is not one loop: the loop through vertex " + c.name(start) + " has " +
+                       std::to_string(c.rim.size()) + " of the " + std::to_string(rim_edges) + " rim edges");
   // A disk has Euler characteristic 1; one rim loop with a handle or a closed component does not.
   detail::TopologyScratch scratch;
   const std::int64_t euler = detail::triangle_topology(disk.triangles, scratch).euler();
@@ -364,13 +363,12 @@ std::array<int, 4> repair_corners(const Connectivity& c, const Loop& loop, std::
     const int k = flat->side;
     const int forward = (corners[0] + flat->lo + 1) % n;   // corner k steps forward to here
     const int backward = (corners[0] + flat->hi - 1) % n;  // or corner k + 1 back to here
-    if (loop.arc(corners[k], forward) <= loop.arc(backward, corners[(k + 1) % 4]))
-      corners[k] = forward;
-    else
-      corners[(k + 1) % 4] = backward;
+    if (loop.arc(corners[k], forward) <= loop.arc(backward, corners[(k + 1) % 4])) corners[k] = forward;
+    else corners[(k + 1) % 4] = backward;
   }
   throw MeshingError("parameterization: no choice of corners keeps every interior edge between rim vertices off a "
-                     "single side of the square (" + std::to_string(chords.size()) + " such edges)");
+                     "single side of the square (" +
+                     std::to_string(chords.size()) + " such edges)");
 }
 
 std::array<int, 4> to_view_ids(const Connectivity& c, const Loop& loop, const std::array<int, 4>& corners) {
@@ -465,7 +463,8 @@ std::array<int, 4> matching_corners(DiskView disk, const std::array<Vector3d, 4>
   const double turn = vector_area(x, c.rim).dot(normal);
   if (!(turn != 0.0))
     throw MeshingError("matching_corners: the rim of S_M does not turn around the given normal (vector area . normal "
-                       "= " + std::to_string(turn) + ")");
+                       "= " +
+                       std::to_string(turn) + ")");
   const int direction = turn > 0.0 ? +1 : -1;
   const Loop around = make_loop(c, x, 0, direction);
   const int n = around.size();
@@ -537,10 +536,9 @@ void require_no_fold(const Connectivity& c, const Loop& loop, const std::array<i
     for (int t : chord.triangles) {
       const auto& tri = c.triangles[t];
       if (std::all_of(tri.begin(), tri.end(), [&](int v) { return sides.position_on(flat->side, v) >= 0; }))
-        throw MeshingError("parameterize_to_square: triangle " + std::to_string(t) + " (vertices " +
-                           c.name(tri[0]) + ", " + c.name(tri[1]) + ", " + c.name(tri[2]) +
-                           ") has all three vertices on " + side_names[flat->side] +
-                           " of the square: it would be flat; choose other corners");
+        throw MeshingError("parameterize_to_square: triangle " + std::to_string(t) + " (vertices " + c.name(tri[0]) +
+                           ", " + c.name(tri[1]) + ", " + c.name(tri[2]) + ") has all three vertices on " +
+                           side_names[flat->side] + " of the square: it would be flat; choose other corners");
     }
     if (fold.empty())
       fold = "parameterize_to_square: interior edge " + c.name(chord.a) + "-" + c.name(chord.b) +
@@ -593,10 +591,8 @@ void solve_interior(const Connectivity& c, const std::vector<Vector3d>& x, Float
   for (int r = 0; r < m; ++r) {
     entries.emplace_back(r, r, 1.0);
     for (const auto& [j, w] : rows[r]) {
-      if (unknown[j] >= 0)
-        entries.emplace_back(r, unknown[j], -w);
-      else
-        rhs.row(r) += w * uv[j].transpose();
+      if (unknown[j] >= 0) entries.emplace_back(r, unknown[j], -w);
+      else rhs.row(r) += w * uv[j].transpose();
     }
   }
   Eigen::SparseMatrix<double> matrix(m, m);
@@ -667,8 +663,8 @@ ParametricSurface::ParametricSurface(DiskView disk, SquareParameterization param
   uv_.resize(c.global.size());
   for (std::size_t v = 0; v < uv_.size(); ++v) {
     uv_[v] = parameterization_.uv[c.global[v]];
-    if (!uv_[v].allFinite()) throw std::invalid_argument("ParametricSurface: vertex " + c.name(static_cast<int>(v)) +
-                                                         " has no parameters");
+    if (!uv_[v].allFinite())
+      throw std::invalid_argument("ParametricSurface: vertex " + c.name(static_cast<int>(v)) + " has no parameters");
   }
   triangles_ = std::move(c.triangles);
   neighbours_ = std::move(c.neighbours);
@@ -745,8 +741,7 @@ ParametricSurface::Location ParametricSurface::grid_search(const Vector2d& uv) c
   return inside(best, best_coordinates);
 }
 
-std::optional<ParametricSurface::Location> ParametricSurface::walk(const Vector2d& uv, int start,
-                                                                     int max_steps) const {
+std::optional<ParametricSurface::Location> ParametricSurface::walk(const Vector2d& uv, int start, int max_steps) const {
   if (start < 0 || start >= triangle_count())
     throw std::invalid_argument("ParametricSurface::walk: no triangle " + std::to_string(start));
   if (max_steps < 0) throw std::invalid_argument("ParametricSurface::walk: negative step limit");

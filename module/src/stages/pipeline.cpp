@@ -1,7 +1,7 @@
 #include <meccano/stages/pipeline.hpp>
 
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/mesh/invariants.hpp>
 
 #include "mesh/topology_helpers.hpp"
@@ -62,9 +62,9 @@ void check_stage(const TetMesh& mesh, const char* stage) {
 
 void report_volumetric(const InsertionOptions& options, const std::string& name, const VolumetricStats& stats,
                        const TetMesh& mesh) {
-  report(options, "volumetric ", name, ": ", stats.refinement_passes, " refinement passes, ",
-         stats.bisections, " bisections, ", stats.tets_intersecting, " tets meet S; grown to ", stats.tets,
-         " tets (", stats.euler_node_stars, " node stars, ", stats.cavity_tets, " cavity tets, ", stats.axis_tets,
+  report(options, "volumetric ", name, ": ", stats.refinement_passes, " refinement passes, ", stats.bisections,
+         " bisections, ", stats.tets_intersecting, " tets meet S; grown to ", stats.tets, " tets (",
+         stats.euler_node_stars, " node stars, ", stats.cavity_tets, " cavity tets, ", stats.axis_tets,
          " axis tets); mesh ", mesh.num_tets(), " tets");
 }
 
@@ -73,10 +73,9 @@ void report_approximation(const InsertionOptions& options, const SurfaceInsertio
   report(options, "approximation ", inserted.name, ": side ", h.side > 0 ? "+" : "-", ", ", h.passes,
          " healing passes; ", h.faces, " faces, ", h.rim_nodes, " rim nodes; extension ", h.extension_faces,
          ", corbels ", h.corbels, ", reflex corners filled ", h.reflex_corners_filled, " left ", h.reflex_corners_left,
-         ", tets with two faces ",
-         h.tets_with_two_faces, ", triangles with two rim edges ", h.triangles_with_two_rim_edges,
-         ", cross-surface edges ", h.cross_surface_edges, ", dividing edges ", h.dividing_edges, ", chord edges ", h.chord_edges, "; mesh ",
-         mesh.num_tets(), " tets");
+         ", tets with two faces ", h.tets_with_two_faces, ", triangles with two rim edges ",
+         h.triangles_with_two_rim_edges, ", cross-surface edges ", h.cross_surface_edges, ", dividing edges ",
+         h.dividing_edges, ", chord edges ", h.chord_edges, "; mesh ", mesh.num_tets(), " tets");
 }
 
 void report_projection(const InsertionOptions& options, const SurfaceInsertion& inserted) {
@@ -90,10 +89,11 @@ void report_projection(const InsertionOptions& options, const SurfaceInsertion& 
 SmoothingOptions smoothing_options_reporting_sweeps(const InsertionOptions& options) {
   SmoothingOptions smoothing_options = options.smoothing;
   if (options.progress)
-    smoothing_options.on_sweep = [&options, caller_on_sweep = options.smoothing.on_sweep](int sweep, const SweepRecord& record) {
+    smoothing_options.on_sweep =
+        [&options, caller_on_sweep = options.smoothing.on_sweep](int sweep, const SweepRecord& record) {
       if (caller_on_sweep) caller_on_sweep(sweep, record);
-      report(options, "smoothing sweep ", sweep, ": ", record.inverted, " tets inverted, quality min ", record.min_quality,
-             " mean ", record.mean_quality,
+      report(options, "smoothing sweep ", sweep, ": ", record.inverted, " tets inverted, quality min ",
+             record.min_quality, " mean ", record.mean_quality,
              record.target == SmoothingTarget::equilateral ? " towards the equilateral target" : "", ", ",
              record.nodes_optimised, " nodes optimised");
     };
@@ -103,21 +103,23 @@ SmoothingOptions smoothing_options_reporting_sweeps(const InsertionOptions& opti
 void report_smoothing(const InsertionOptions& options, const SmoothingStats& smoothing) {
   const SweepRecord last = smoothing.sweeps.empty() ? SweepRecord{} : smoothing.sweeps.back();
   report(options, "smoothing: ",
-         smoothing.inner_nodes + smoothing.box_nodes + smoothing.surface_nodes + smoothing.rim_nodes + smoothing.crease_nodes,
+         smoothing.inner_nodes + smoothing.box_nodes + smoothing.surface_nodes + smoothing.rim_nodes +
+             smoothing.crease_nodes,
          " free nodes (", smoothing.surface_nodes, " on surfaces, ", smoothing.rim_nodes, " on rims, ",
-         smoothing.crease_nodes, " on creases), ", smoothing.colours,
-         " colours; ", smoothing.inverted_before, " inverted tets before, ", smoothing.inverted_after, " after ",
-         smoothing.sweeps.size(), " sweeps (untangled after ", smoothing.untangling_sweeps,
-         smoothing.fallback_sweep > 0 ? ", towards the equilateral target from sweep " + std::to_string(smoothing.fallback_sweep)
-                                      : std::string(),
+         smoothing.crease_nodes, " on creases), ", smoothing.colours, " colours; ", smoothing.inverted_before,
+         " inverted tets before, ", smoothing.inverted_after, " after ", smoothing.sweeps.size(),
+         " sweeps (untangled after ", smoothing.untangling_sweeps,
+         smoothing.fallback_sweep > 0
+             ? ", towards the equilateral target from sweep " + std::to_string(smoothing.fallback_sweep)
+             : std::string(),
          "); quality min ", last.min_quality, " mean ", last.mean_quality);
 }
 
 void report_improvement(const InsertionOptions& options, const ImprovementOptions& improvement,
                         const ImprovementStats& improved) {
-  report(options, "improvement: ", improved.passes, " passes over the tets below ", improvement.threshold,
-         " (", improved.tets_below_before, " before, ", improved.tets_below_after, " after), ", improved.nodes_moved,
-         " of ", improved.node_updates, " node updates moved",
+  report(options, "improvement: ", improved.passes, " passes over the tets below ", improvement.threshold, " (",
+         improved.tets_below_before, " before, ", improved.tets_below_after, " after), ", improved.nodes_moved, " of ",
+         improved.node_updates, " node updates moved",
          improvement.topology ? "; " + std::to_string(improved.rounds) + " rounds of flips: " + describe(improved.flips)
                               : std::string(),
          "; smallest quality ", improved.min_quality_before, " -> ", improved.min_quality_after, " (equilateral)");
@@ -204,22 +206,24 @@ void project_onto_surfaces(InsertionResult& result, std::span<const TriangleSurf
 }
 
 // Step 4: untangling and smoothing, every surface's nodes moving within it.
-void untangle_and_smooth(InsertionResult& result, std::span<SurfaceProjection* const> projections, const InsertionOptions& options) {
+void untangle_and_smooth(InsertionResult& result, std::span<SurfaceProjection* const> projections,
+                         const InsertionOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   result.smoothing = smooth_mesh(result.mesh, projections, smoothing_options_reporting_sweeps(options));
   result.smoothing_seconds = seconds_since(start);
   report_smoothing(options, result.smoothing);
 }
 
-void lift_worst_tets(InsertionResult& result, std::span<SurfaceProjection* const> projections, const InsertionOptions& options) {
+void lift_worst_tets(InsertionResult& result, std::span<SurfaceProjection* const> projections,
+                     const InsertionOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   ImprovementOptions improvement = options.improvement;
   improvement.topology = options.improve == Improvement::topology;
   if (options.progress) improvement.progress = options.progress;
   std::vector<TetRegion*> regions;
   for (SurfaceInsertion& inserted : result.surfaces) regions.push_back(&inserted.volumetric);
-  const ImprovementStats& improved = result.improvement.emplace(
-      improve_worst_tets(result.mesh, projections, improvement, options.smoothing, regions));
+  const ImprovementStats& improved =
+      result.improvement.emplace(improve_worst_tets(result.mesh, projections, improvement, options.smoothing, regions));
   result.improvement_seconds = seconds_since(started);
   report_improvement(options, improvement, improved);
 }
@@ -318,7 +322,8 @@ std::string per_surface(std::span<const TriangleSurface> surfaces, std::span<con
   if (std::ranges::all_of(values, [&](const Value& value) { return value == values.front(); }))
     return text(values.front());
   std::string listed;
-  for (std::size_t s = 0; s < surfaces.size(); ++s) listed += (s > 0 ? ", " : "") + surfaces[s].name + " " + text(values[s]);
+  for (std::size_t s = 0; s < surfaces.size(); ++s)
+    listed += (s > 0 ? ", " : "") + surfaces[s].name + " " + text(values[s]);
   return listed;
 }
 
@@ -406,8 +411,8 @@ InsertionResult insert_on_either_side(const TetMesh& mesh, std::span<const Trian
     }
   };
   auto untangling_failed = [&](const InsertionResult& tangled, std::span<const SideRule> sides) {
-    failed.push_back(
-        {attempt_settings(surfaces, resolutions, sides), tets_still_inverted(tangled), untangling_explanation(options)});
+    failed.push_back({attempt_settings(surfaces, resolutions, sides), tets_still_inverted(tangled),
+                      untangling_explanation(options)});
     return untangling_failure(tangled);
   };
   InsertionResult result = run(rules);
@@ -464,13 +469,14 @@ std::int64_t estimate_tets(const MeccanoGrid& meccano, std::int64_t meccano_tets
   double cubes = 0.0, rim_cubes = 0.0;
   for (const TriangleSurface& surface : surfaces) {
     for (const auto& [a, b, c] : surface.triangles) {
-      const Eigen::Vector3d area = 0.5 * (surface.points[b] - surface.points[a]).cross(surface.points[c] - surface.points[a]);
+      const Eigen::Vector3d area =
+          0.5 * (surface.points[b] - surface.points[a]).cross(surface.points[c] - surface.points[a]);
       cubes += area.cwiseAbs().dot(per_area);
     }
     rim_cubes += rim_length(surface) / std::cbrt(h.prod());
   }
-  const double total = static_cast<double>(meccano_tets) + tets_per_cube[level % 3] * cubes +
-                       tets_per_rim_cube[level % 3] * rim_cubes;
+  const double total =
+      static_cast<double>(meccano_tets) + tets_per_cube[level % 3] * cubes + tets_per_rim_cube[level % 3] * rim_cubes;
   return total < 0x1p62 ? static_cast<std::int64_t>(total) : std::int64_t{1} << 62;
 }
 
@@ -538,14 +544,15 @@ double finer_resolution(const MeccanoGrid& meccano, const Clearances& clearance,
     if (other != s) gap = std::min(gap, clearance.between[s][other]);
   double finer = resolution / 2.0;
   for (int level = level_for_resolution(meccano, finer); room_needed(meccano, finer, finer) >= gap; ++level) {
-    if (level >= finest_level) break;  // the surfaces practically touch: the tet limit decides
+    if (level >= finest_level) break;               // the surfaces practically touch: the tet limit decides
     finer = longest_edge_at_level(meccano, level);  // the coarsest l_r of the next level
   }
   return finer;
 }
 
 // The insertion at l_r, and where it fails, again with the failing surfaces at a finer l_r.
-InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options) {
+InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces,
+                                const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();
   std::int64_t estimated_tets = mesh.num_tets();
   if (!surfaces.empty()) {
@@ -559,8 +566,8 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
   const ThreadCount threads(options.threads);
   std::vector<double> resolutions(surfaces.size(), options.resolution);
   std::vector<std::string> failures;  // why each finer retry was made, for the result
-  std::vector<FailedAttempt> failed;   // every run of the stages that failed, for the final message
-  Clearances clearance;                // computed at the first failure
+  std::vector<FailedAttempt> failed;  // every run of the stages that failed, for the final message
+  Clearances clearance;               // computed at the first failure
   for (int retry = 0;; ++retry) {
     std::vector<int> failing;
     try {
@@ -574,8 +581,9 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
       failing = failure.surfaces;
     }
     if (retry == options.finer_retries)
-      throw MeshingError(final_failure(failed, "more finer retries (--finer-retries, InsertionOptions::finer_retries; " +
-                                                   std::to_string(options.finer_retries) + " here) may succeed"));
+      throw MeshingError(
+          final_failure(failed, "more finer retries (--finer-retries, InsertionOptions::finer_retries; " +
+                                    std::to_string(options.finer_retries) + " here) may succeed"));
     std::int64_t estimate = mesh.num_tets();
     std::ostringstream finer;
     finer.precision(6);
@@ -588,7 +596,8 @@ InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> s
     }
     for (std::size_t s = 0; s < surfaces.size(); ++s)
       estimate += estimate_tets(mesh.meccano, 0, surfaces.subspan(s, 1), resolutions[s]);
-    if (estimate > options.max_tets) throw MeshingError(final_failure(failed, "a finer l_r would exceed the tet limit"));
+    if (estimate > options.max_tets)
+      throw MeshingError(final_failure(failed, "a finer l_r would exceed the tet limit"));
     report(options, "retrying with ", finer.str(), " (", failures.back(), ")");
   }
 }

@@ -69,7 +69,8 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
   for (const auto& t : triangles) {
     std::array<int, 3>& local = result.triangles.emplace_back();
     for (int k = 0; k < 3; ++k)
-      local[k] = static_cast<int>(std::lower_bound(result.nodes.begin(), result.nodes.end(), t[k]) - result.nodes.begin());
+      local[k] =
+          static_cast<int>(std::lower_bound(result.nodes.begin(), result.nodes.end(), t[k]) - result.nodes.begin());
   }
   result.creases = follow_creases(crease_lines(surface, result.surface->parameterization().uv, options.crease_angle),
                                   result.triangles, result.uv, result.on_rim, result.orientation);

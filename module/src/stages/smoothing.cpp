@@ -72,7 +72,8 @@ struct StarTet {
 };
 
 StarTet star_tet(const Matrix3d& s, const Matrix3d& target_inverse, int k) {
-  const Vector3d b = k == 0 ? Vector3d(-target_inverse.colwise().sum().transpose()) : Vector3d(target_inverse.row(k - 1));
+  const Vector3d b =
+      k == 0 ? Vector3d(-target_inverse.colwise().sum().transpose()) : Vector3d(target_inverse.row(k - 1));
   return {s.squaredNorm(), b.squaredNorm(), s.determinant(), s * b, cofactor(s) * b};
 }
 
@@ -97,9 +98,9 @@ Distortion distortion_derivatives(const StarTet& tet, const Vector3d& d) {
   const Vector3d grad_n = 2.0 * (tet.u + tet.beta * d);
   const Vector3d a = grad_n / n - (2.0 / 3.0) * tet.w / r;
   f.gradient = f.value * a;
-  f.hessian = f.value * (a * a.transpose() + (2.0 * tet.beta / n) * Matrix3d::Identity() -
-                         grad_n * grad_n.transpose() / (n * n) +
-                         (2.0 / 3.0) * sigma / (r * r * r) * tet.w * tet.w.transpose());
+  f.hessian =
+      f.value * (a * a.transpose() + (2.0 * tet.beta / n) * Matrix3d::Identity() -
+                 grad_n * grad_n.transpose() / (n * n) + (2.0 / 3.0) * sigma / (r * r * r) * tet.w * tet.w.transpose());
   return f;
 }
 
@@ -135,8 +136,7 @@ Parameters descent_direction(Matrix3d h, const Parameters& g, const Jacobian& j)
   for (int i = 0; i < 3; ++i)
     if (j.col(i).squaredNorm() == 0.0) h(i, i) = 1.0;  // an unused parameter: g_i = 0, so its step is 0
   const Eigen::LLT<Matrix3d> cholesky(h);
-  if (cholesky.info() == Eigen::Success &&
-      cholesky.matrixLLT().diagonal().cwiseAbs2().minCoeff() >= 1e-8 * h.trace())
+  if (cholesky.info() == Eigen::Success && cholesky.matrixLLT().diagonal().cwiseAbs2().minCoeff() >= 1e-8 * h.trace())
     return -cholesky.solve(g);
   const Eigen::SelfAdjointEigenSolver<Matrix3d> eigen(h);
   Parameters magnitudes = eigen.eigenvalues().cwiseAbs();
@@ -222,7 +222,8 @@ class Smoother {
         Matrix3d w;
         for (int k = 0; k < 3; ++k)
           for (int axis = 0; axis < 3; ++axis)
-            w(axis, k) = mesh_.meccano.cell_size[axis] * static_cast<double>(edges[3 * k + axis]) / static_cast<double>(grid_cell);
+            w(axis, k) = mesh_.meccano.cell_size[axis] * static_cast<double>(edges[3 * k + axis]) /
+                         static_cast<double>(grid_cell);
         target_inverses_.push_back(w.inverse());
       }
       target_of_tet_[t] = shape->second;
@@ -286,7 +287,8 @@ class Smoother {
   SweepRecord record_sweep(std::int64_t optimised, std::chrono::steady_clock::time_point start) const;
   std::optional<double> comparable_objective() const;
   bool untangling_stuck(const SweepRecord& record, SweepState& state);
-  bool smoothing_done(int sweep, const SweepRecord& record, std::optional<double> previous_objective, SweepState& state);
+  bool smoothing_done(int sweep, const SweepRecord& record, std::optional<double> previous_objective,
+                      SweepState& state);
   // The exponent p of Σ η*^p: the paper's 1 while tangled, options_.power once a sweep ends untangled;
   // the improvement's own.
   double power() const { return improving_ ? improving_->power : tangled_ ? 1.0 : options_.power; }
@@ -297,7 +299,7 @@ class Smoother {
   VertexTets stars_;
   std::vector<std::array<VertexId, 4>> oriented_;
   SmoothingTarget target_ = SmoothingTarget::meccano;  // what the W^-1 are for now
-  std::vector<Matrix3d> target_inverses_;  // one per shape of tet
+  std::vector<Matrix3d> target_inverses_;              // one per shape of tet
   std::vector<std::uint32_t> target_of_tet_;
   bool returned_from_fallback_ = false;  // did the smoothing aim at the meccano target again after the fallback?
   std::vector<NodeFreedom> freedom_;
@@ -305,11 +307,11 @@ class Smoother {
   std::vector<std::vector<int>> triangle_start_, node_triangles_;  // per surface: node -> S_M triangles (CSR)
   std::vector<TetId> active_tets_;
   SmoothingStats stats_;
-  bool tangled_ = true;               // did the last sweep end with inverted tets (or none ran yet)?
+  bool tangled_ = true;  // did the last sweep end with inverted tets (or none ran yet)?
   static constexpr double initial_untangling_epsilon = 1e-3;
   double untangling_epsilon_ = initial_untangling_epsilon;  // ε / mean|σ|, raised while untangling stalls
-  const ImprovementOptions* improving_ = nullptr;  // set while improve() runs
-  std::vector<Matrix3d> guard_inverses_;            // improving: the meccano target's W^-1, per shape
+  const ImprovementOptions* improving_ = nullptr;           // set while improve() runs
+  std::vector<Matrix3d> guard_inverses_;                    // improving: the meccano target's W^-1, per shape
   std::vector<std::uint32_t> guard_of_tet_;
 };
 
@@ -319,7 +321,8 @@ void Smoother::classify_nodes() {
   for (VertexId v = 0; v < mesh_.num_vertices(); ++v) {
     NodeFreedom& node = freedom_[v];
     for (int axis = 0; axis < 3; ++axis)
-      if (mesh_.grid[v][axis] == 0 || mesh_.grid[v][axis] == upper[axis]) node.free_axes &= static_cast<std::uint8_t>(~(1u << axis));
+      if (mesh_.grid[v][axis] == 0 || mesh_.grid[v][axis] == upper[axis])
+        node.free_axes &= static_cast<std::uint8_t>(~(1u << axis));
     if (node.free_axes == 0) node.kind = Freedom::fixed;
     else if (node.free_axes != 7) node.kind = Freedom::box;
   }
@@ -495,24 +498,18 @@ Jacobian Smoother::jacobian(VertexId v, const Placement& at) const {
   const NodeFreedom& node = freedom_[v];
   Jacobian j = Jacobian::Zero();
   switch (node.kind) {
-    case Freedom::space:
-      return Jacobian::Identity();
+    case Freedom::space: return Jacobian::Identity();
     case Freedom::box:
       for (int axis = 0, column = 0; axis < 3; ++axis)
         if (node.free_axes & (1u << axis)) j(axis, column++) = 1.0;
       break;
-    case Freedom::surface:
-      j.leftCols<2>() = surfaces_[node.surface]->surface->derivative(at.triangle);
-      break;
-    case Freedom::rim:
-      j.col(0) = surfaces_[node.surface]->surface->derivative(at.triangle).col(node.rim_axis);
-      break;
+    case Freedom::surface: j.leftCols<2>() = surfaces_[node.surface]->surface->derivative(at.triangle); break;
+    case Freedom::rim: j.col(0) = surfaces_[node.surface]->surface->derivative(at.triangle).col(node.rim_axis); break;
     case Freedom::crease:
       // φ is continuous across the crease edge and affine along it: either triangle gives this column.
       j.col(0) = surfaces_[node.surface]->surface->derivative(at.triangle) * node.crease->direction(at.arc);
       break;
-    case Freedom::fixed:
-      break;
+    case Freedom::fixed: break;
   }
   return j;
 }
@@ -524,9 +521,7 @@ bool Smoother::move(VertexId v, const Placement& from, const Parameters& step, P
   const NodeFreedom& node = freedom_[v];
   to = from;
   switch (node.kind) {
-    case Freedom::space:
-      to.x += step;
-      return true;
+    case Freedom::space: to.x += step; return true;
     case Freedom::box: {
       const Box& box = mesh_.meccano.box;
       for (int axis = 0, column = 0; axis < 3; ++axis)
@@ -550,8 +545,7 @@ bool Smoother::move(VertexId v, const Placement& from, const Parameters& step, P
       if (!(to.arc > 0.0 && to.arc < node.crease->length())) return false;
       to.uv = node.crease->at(to.arc);
       break;
-    case Freedom::fixed:
-      return false;
+    case Freedom::fixed: return false;
   }
   if (!keeps_surface_embedded(node, to.uv)) return false;
   const ParametricSurface& surface = *surfaces_[node.surface]->surface;
@@ -568,7 +562,8 @@ bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& u
   const SurfaceProjection& projection = *surfaces_[node.surface];
   const auto& start = triangle_start_[node.surface];
   for (int k = start[node.index]; k < start[node.index + 1]; ++k)
-    if (!keeps_orientation(projection, projection.triangles[node_triangles_[node.surface][k]], node.index, uv)) return false;
+    if (!keeps_orientation(projection, projection.triangles[node_triangles_[node.surface][k]], node.index, uv))
+      return false;
   return true;
 }
 
@@ -595,7 +590,9 @@ bool Smoother::optimise(VertexId v) {
   };
   double worst_at = improving_ ? worst(star, Vector3d::Zero()) : 0.0;
   double guard_at = improving_ ? std::max(worst(guard, Vector3d::Zero()), 1.0 / improving_->threshold) : 0.0;
-  const int steps = improving_ ? improving_->newton_steps : tangled_ ? 2 * options_.newton_steps : options_.newton_steps;
+  const int steps = improving_ ? improving_->newton_steps
+                    : tangled_ ? 2 * options_.newton_steps
+                               : options_.newton_steps;
   for (int step = 0; step < steps; ++step) {
     const double value = model.value;
     const Jacobian j = jacobian(v, at);
@@ -784,8 +781,7 @@ bool Smoother::smoothing_done(int sweep, const SweepRecord& record, std::optiona
     returned_from_fallback_ = true;
     return false;
   }
-  return previous_objective &&
-         *previous_objective - record.objective <= options_.tolerance * *previous_objective;
+  return previous_objective && *previous_objective - record.objective <= options_.tolerance * *previous_objective;
 }
 
 SmoothingStats Smoother::run() {
@@ -841,7 +837,8 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
     return nodes;
   };
   auto below_threshold = [&] {
-    return static_cast<std::int64_t>(std::count_if(quality.begin(), quality.end(), [&](double q) { return q < options.threshold; }));
+    return static_cast<std::int64_t>(
+        std::count_if(quality.begin(), quality.end(), [&](double q) { return q < options.threshold; }));
   };
   std::vector<TetId> all(mesh_.tets.size());
   std::iota(all.begin(), all.end(), TetId{0});
@@ -881,14 +878,14 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
 
 }  // namespace
 
-Distortion regularised_distortion(const TetPoints& physical, const Matrix3d& target_inverse, int vertex,
-                                  double delta) {
+Distortion regularised_distortion(const TetPoints& physical, const Matrix3d& target_inverse, int vertex, double delta) {
   StarTet tet = star_tet(edge_matrix(physical) * target_inverse, target_inverse, vertex);
   tet.delta = delta;
   return distortion_derivatives(tet, Vector3d::Zero());
 }
 
-SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, const SmoothingOptions& options) {
+SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
+                           const SmoothingOptions& options) {
   return Smoother(mesh, surfaces, options).run();
 }
 
@@ -898,7 +895,8 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
   // improve() sets both targets; SUS's mode and band decide which nodes are free. A flip changes the
   // stars, so each round smooths with a Smoother built afresh.
   auto smooth = [&](std::span<const std::uint8_t> only) {
-    return Smoother(mesh, surfaces, {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})
+    return Smoother(mesh, surfaces,
+                    {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})
         .improve(options, only);
   };
   const FlipStats mends = options.topology ? conform_to_creases(mesh, surfaces, regions, options) : FlipStats{};

@@ -1,7 +1,7 @@
 #include <meccano/stages/surface_approximation.hpp>
 
-#include <meccano/mesh/bisection.hpp>
 #include <meccano/error.hpp>
+#include <meccano/mesh/bisection.hpp>
 
 #include "mesh/topology_helpers.hpp"
 
@@ -153,15 +153,14 @@ VolumeBoundary read_volume_boundary(const TetMesh& mesh, const TetRegion& volume
 // Keeps the largest component of S_M and fills its holes (all components of the rest of ∂V_M but the
 // largest, unless they reach the box). Returns {faces removed, faces added}.
 std::pair<std::int64_t, std::int64_t> keep_one_component_without_holes(TetMesh& mesh, const TetRegion& volumetric,
-                                                                        FaceTag tag) {
+                                                                       FaceTag tag) {
   const VolumeBoundary boundary = read_volume_boundary(mesh, volumetric);
   const std::size_t n = boundary.faces.size();
   std::vector<std::uint8_t> in_interface(n);
   for (std::size_t i = 0; i < n; ++i)
     in_interface[i] = mesh.face_tags[boundary.faces[i].tet][boundary.faces[i].local_face] == tag;
-  const auto label = edge_components(boundary.nodes, [&](std::size_t a, std::size_t b) {
-    return in_interface[a] == in_interface[b];
-  });
+  const auto label =
+      edge_components(boundary.nodes, [&](std::size_t a, std::size_t b) { return in_interface[a] == in_interface[b]; });
   // Component sizes, per side of the partition.
   std::vector<std::int64_t> size(n, 0);
   std::vector<std::uint8_t> reaches_box(n, 0);
@@ -451,8 +450,9 @@ std::vector<FaceRef> missing_squares_at(const TetMesh& mesh, const TetRegion& vo
   std::vector<FaceRef> missing;
   auto wanted = [&](TetId t, int f) {
     return is_volume_boundary_face(mesh, volumetric, t, f) && mesh.neighbours[t][f] != no_tet &&
-           mesh.face_tags[t][f] != tag &&
-           std::none_of(missing.begin(), missing.end(), [&](const FaceRef& m) { return m.tet == t && m.local_face == f; });
+           mesh.face_tags[t][f] != tag && std::none_of(missing.begin(), missing.end(), [&](const FaceRef& m) {
+             return m.tet == t && m.local_face == f;
+           });
   };
   for (TetId t : incidence.of(node))
     for (int f = 0; f < 4; ++f)
@@ -549,7 +549,8 @@ std::string tag_faces_on_side(TetMesh& mesh, const TetRegion& volumetric, const 
     }
   }
   if (stats.initial_faces > 0) return {};
-  const bool touches_box = std::any_of(boundary.on_box.begin(), boundary.on_box.end(), [](std::uint8_t b) { return b; });
+  const bool touches_box =
+      std::any_of(boundary.on_box.begin(), boundary.on_box.end(), [](std::uint8_t b) { return b; });
   return touches_box ? "V_M reaches the box boundary on this side of S: the surface is too close to the box "
                        "for this resolution"
                      : "no boundary face of V_M has its three nodes on this side of S";
@@ -578,10 +579,12 @@ std::int64_t fill_reflex_corners(TetMesh& mesh, const TetRegion& volumetric,
     if (std::binary_search(history.left.begin(), history.left.end(), node)) continue;
     const auto missing = missing_squares_at(mesh, volumetric, incidence, node, tag);
     const bool filled_before = std::binary_search(history.filled.begin(), history.filled.end(), node);
-    const bool can_fill = !filled_before && !missing.empty() && std::all_of(missing.begin(), missing.end(), [&](const FaceRef& f) {
+    const bool can_fill = !filled_before && !missing.empty() &&
+                          std::all_of(missing.begin(), missing.end(),
+                                      [&](const FaceRef& f) {
       const auto nodes_of_face = face_nodes(mesh, f.tet, f.local_face);
       return std::all_of(nodes_of_face.begin(), nodes_of_face.end(), [&](VertexId v) { return side_of(v) != -side; });
-    });
+                          });
     if (can_fill) {
       for (const FaceRef& f : missing) set_face_tag(mesh, f.tet, f.local_face, tag);
       filled_now += static_cast<std::int64_t>(missing.size());
@@ -681,13 +684,12 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
 
 std::string SurfaceApproximationCheck::describe() const {
   std::ostringstream out;
-  out << faces << " faces, " << (connected ? "connected" : "disconnected") << ", Euler characteristic " << euler
-      << ", " << rim_loops << " rim loop(s), " << pinched_nodes << " pinched node(s), " << non_manifold_edges
+  out << faces << " faces, " << (connected ? "connected" : "disconnected") << ", Euler characteristic " << euler << ", "
+      << rim_loops << " rim loop(s), " << pinched_nodes << " pinched node(s), " << non_manifold_edges
       << " non-manifold edge(s), " << oblique_rim_edges << " oblique rim edge(s), " << corbels << " corbel(s), "
-      << reflex_rim_corners << " reflex rim corner(s) (allowed), " << tets_with_two_faces
-      << " tet(s) with two faces, " << triangles_with_two_rim_edges << " triangle(s) with two rim edges, "
-      << cross_surface_edges << " cross-surface edge(s), " << dividing_edges << " dividing edge(s), " << chord_edges
-      << " chord edge(s), "
+      << reflex_rim_corners << " reflex rim corner(s) (allowed), " << tets_with_two_faces << " tet(s) with two faces, "
+      << triangles_with_two_rim_edges << " triangle(s) with two rim edges, " << cross_surface_edges
+      << " cross-surface edge(s), " << dividing_edges << " dividing edge(s), " << chord_edges << " chord edge(s), "
       << nodes_on_box_or_other_surface << " node(s) on the box or another surface";
   return out.str();
 }
@@ -725,9 +727,9 @@ InterfaceFaces interface_faces(const TetMesh& mesh, const TetRegion& volumetric,
   const Interface s = read_interface(mesh, volumetric, interface_tag(index));
   for (const FaceRef& f : s.faces) {
     // The V_M tet's outward normal points away from V_M, i.e. to the side S_M lies on.
-    const FaceRef oriented =
-        side > 0 ? f : FaceRef{mesh.neighbours[f.tet][f.local_face],
-                               mesh.face_towards(mesh.neighbours[f.tet][f.local_face], f.tet)};
+    const FaceRef oriented = side > 0 ? f
+                                      : FaceRef{mesh.neighbours[f.tet][f.local_face],
+                                                mesh.face_towards(mesh.neighbours[f.tet][f.local_face], f.tet)};
     result.faces.push_back(oriented);
     result.triangles.push_back(mesh.outward_face(oriented.tet, oriented.local_face));
   }

@@ -1,7 +1,7 @@
 #include <meccano/stages/volumetric_approximation.hpp>
 
-#include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/error.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
 
 #include "mesh/topology_helpers.hpp"
 
@@ -44,8 +44,8 @@ bool link_is_disk(const TetMesh& mesh, const TetRegion& region, const VertexTets
   }
   if (triangles.empty()) return false;
   const TriangleTopology link = triangle_topology(triangles, scratch.topology);
-  return link.overloaded_edges == 0 && link.boundary_edges > 0 && link.components == 1 &&
-         link.pinched_vertices == 0 && link.euler() == 1;
+  return link.overloaded_edges == 0 && link.boundary_edges > 0 && link.components == 1 && link.pinched_vertices == 0 &&
+         link.euler() == 1;
 }
 
 // Flags, for each node in `nodes`, whether its link in the region is not a disk (in parallel).
@@ -266,10 +266,14 @@ class BallGrowth {
  public:
   BallGrowth(TetMesh& mesh, TetRegion& region, const VolumetricOptions& options, VolumetricStats& stats,
              std::vector<TetRegion*> other_regions, const TriangleBVH* surface)
-      : mesh_(mesh), region_(region), stats_(stats), surface_(surface),
+      : mesh_(mesh),
+        region_(region),
+        stats_(stats),
+        surface_(surface),
         follow_others_(region_follows_children(std::move(other_regions))),
         target_level_(level_for_resolution(mesh.meccano, options.resolution)),
-        reach_(growth_reach(mesh.meccano, options.resolution)), band_(reach_ * growth_band) {
+        reach_(growth_reach(mesh.meccano, options.resolution)),
+        band_(reach_ * growth_band) {
     stats.reach = reach_;
   }
 
@@ -321,10 +325,10 @@ class BallGrowth {
   MeshingError beyond_band(TetId t, double farthest) const {
     const Eigen::Vector3d at = mesh_.points[mesh_.tets[t][0]];
     return MeshingError("the volumetric approximation cannot be grown into a ball within reach of the surface "
-                        "near (" + std::to_string(at.x()) + ", " + std::to_string(at.y()) + ", " +
-                        std::to_string(at.z()) + "): the ball must reach " + std::to_string(farthest / reach_) +
-                        " times the reach " + std::to_string(reach_) +
-                        " from it; a smaller l_r resolves this part of the surface");
+                        "near (" +
+                        std::to_string(at.x()) + ", " + std::to_string(at.y()) + ", " + std::to_string(at.z()) +
+                        "): the ball must reach " + std::to_string(farthest / reach_) + " times the reach " +
+                        std::to_string(reach_) + " from it; a smaller l_r resolves this part of the surface");
   }
 
   TetMesh& mesh_;

@@ -30,7 +30,8 @@ CreaseGraph crease_graph(const TriangleSurface& surface, double angle) {
   std::vector<Vector3d> normals;
   normals.reserve(surface.triangles.size());
   for (const auto& [a, b, c] : surface.triangles)
-    normals.push_back((surface.points[b] - surface.points[a]).cross(surface.points[c] - surface.points[a]).normalized());
+    normals.push_back(
+        (surface.points[b] - surface.points[a]).cross(surface.points[c] - surface.points[a]).normalized());
   CreaseGraph graph{std::vector<std::vector<std::pair<int, double>>>(surface.points.size()),
                     std::vector<std::uint8_t>(surface.points.size(), 0)};
   const auto edges = edges_with_triangles(surface.triangles);
@@ -244,8 +245,8 @@ void snap_path(int l, std::vector<PathNode>& path, std::span<const std::array<in
 }  // namespace
 
 std::size_t CreaseLine::segment(double s) const {
-  const auto end = std::min<std::size_t>(std::ranges::upper_bound(arc, std::clamp(s, 0.0, length())) - arc.begin(),
-                                         arc.size() - 1);
+  const auto end =
+      std::min<std::size_t>(std::ranges::upper_bound(arc, std::clamp(s, 0.0, length())) - arc.begin(), arc.size() - 1);
   return end == 0 ? 0 : end - 1;
 }
 
@@ -298,7 +299,8 @@ std::vector<CreaseLine> crease_lines(const TriangleSurface& surface, std::span<c
   for (CreaseLine& line : lines) {
     line.arc.push_back(0.0);
     for (const int v : line.vertices) line.uv.push_back(uv[v]);
-    for (std::size_t i = 1; i < line.uv.size(); ++i) line.arc.push_back(line.arc.back() + (line.uv[i] - line.uv[i - 1]).norm());
+    for (std::size_t i = 1; i < line.uv.size(); ++i)
+      line.arc.push_back(line.arc.back() + (line.uv[i] - line.uv[i - 1]).norm());
   }
   return lines;
 }
@@ -319,7 +321,8 @@ CreaseNodes follow_creases(std::vector<CreaseLine> lines, std::span<const std::a
   for (std::size_t l = 0, segment = 0; l < result.lines.size(); ++l) {
     const CreaseLine& line = result.lines[l];
     for (std::size_t i = 0; i + 1 < line.uv.size(); ++i, ++segment)
-      grid.crossings(static_cast<int>(l), line.uv[i], line.uv[i + 1], line.arc[i], static_cast<int>(segment), crossings[l]);
+      grid.crossings(static_cast<int>(l), line.uv[i], line.uv[i + 1], line.arc[i], static_cast<int>(segment),
+                     crossings[l]);
     stats.crossings += static_cast<std::int64_t>(crossings[l].size());
     stats.sharpest = std::max(stats.sharpest, line.angle);
   }
@@ -341,7 +344,8 @@ CreaseNodes follow_creases(std::vector<CreaseLine> lines, std::span<const std::a
   return result;
 }
 
-std::vector<CreaseCrossing> straddling_crossings(const CreaseNodes& creases, std::span<const std::array<int, 3>> triangles,
+std::vector<CreaseCrossing> straddling_crossings(const CreaseNodes& creases,
+                                                 std::span<const std::array<int, 3>> triangles,
                                                  std::span<const Vector2d> uv) {
   std::vector<CreaseCrossing> straddling;
   if (creases.lines.empty()) return straddling;
@@ -350,7 +354,8 @@ std::vector<CreaseCrossing> straddling_crossings(const CreaseNodes& creases, std
     const CreaseLine& line = creases.lines[l];
     std::vector<Crossing> crossings;
     for (std::size_t i = 0; i + 1 < line.uv.size(); ++i, ++segment)
-      grid.crossings(static_cast<int>(l), line.uv[i], line.uv[i + 1], line.arc[i], static_cast<int>(segment), crossings);
+      grid.crossings(static_cast<int>(l), line.uv[i], line.uv[i + 1], line.arc[i], static_cast<int>(segment),
+                     crossings);
     std::ranges::sort(crossings, {}, &Crossing::s);
     const auto on_line = [&](int v) { return creases.line_of[v] == static_cast<int>(l); };
     for (const Crossing& crossing : crossings)

@@ -80,9 +80,8 @@ void check_elements(const TriangleSurface& surface) {
   if (triangles.empty()) fail(surface, "the surface has no triangles");
   for (std::size_t v = 0; v < points.size(); ++v)
     if (!points[v].allFinite())
-      fail(surface, vertex_name(static_cast<int>(v)) + " has a non-finite coordinate (" +
-                        format_number(points[v].x()) + ", " + format_number(points[v].y()) + ", " +
-                        format_number(points[v].z()) + ")");
+      fail(surface, vertex_name(static_cast<int>(v)) + " has a non-finite coordinate (" + format_number(points[v].x()) +
+                        ", " + format_number(points[v].y()) + ", " + format_number(points[v].z()) + ")");
   const auto vertex_count = static_cast<long long>(points.size());
   for (std::size_t t = 0; t < triangles.size(); ++t)
     for (const int v : triangles[t])
@@ -109,8 +108,8 @@ void check_elements(const TriangleSurface& surface) {
     const Eigen::Vector3d& c = points[static_cast<std::size_t>(triangles[t][2])];
     const double area = 0.5 * (b - a).cross(c - a).norm();
     if (area <= min_area)
-      fail(surface, triangle_name(t) + " has zero area (area " + format_number(area) + " <= " +
-                        format_number(min_area) + " = 1e-14 x squared bounding-box diagonal)");
+      fail(surface, triangle_name(t) + " has zero area (area " + format_number(area) +
+                        " <= " + format_number(min_area) + " = 1e-14 x squared bounding-box diagonal)");
   }
 }
 
@@ -139,9 +138,9 @@ void check_no_duplicate_triangles(const TriangleSurface& surface) {
     }
   if (second)
     fail(surface, triangle_name(static_cast<std::size_t>(first->triangle)) + " and " +
-                      triangle_name(static_cast<std::size_t>(second->triangle)) + " are duplicates (both use vertices " +
-                      std::to_string(first->sorted[0] + 1) + ", " + std::to_string(first->sorted[1] + 1) + ", " +
-                      std::to_string(first->sorted[2] + 1) + ")");
+                      triangle_name(static_cast<std::size_t>(second->triangle)) +
+                      " are duplicates (both use vertices " + std::to_string(first->sorted[0] + 1) + ", " +
+                      std::to_string(first->sorted[1] + 1) + ", " + std::to_string(first->sorted[2] + 1) + ")");
 }
 
 void check_manifold_edges(const TriangleSurface& surface, const std::vector<EdgeSide>& sides) {
@@ -151,8 +150,8 @@ void check_manifold_edges(const TriangleSurface& surface, const std::vector<Edge
     for (std::size_t i = first; i < first + count; ++i)
       names += (i == first ? "" : ", ") + std::to_string(sides[i].triangle + 1);
     fail(surface, "non-manifold edge between " + vertex_name(sides[first].low) + " and " +
-                      vertex_name(sides[first].high) + ": shared by " + std::to_string(count) + " triangles (" +
-                      names + ")");
+                      vertex_name(sides[first].high) + ": shared by " + std::to_string(count) + " triangles (" + names +
+                      ")");
   });
 }
 

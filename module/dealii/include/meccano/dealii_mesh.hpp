@@ -40,15 +40,15 @@
 namespace meccano {
 
 struct DealiiInterface {
-  std::string name;                          // NAME of interface_NAME
-  dealii::types::manifold_id tag = 0;        // the manifold id of its faces
-  std::vector<dealii::Point<3>> corners;     // 3 per triangle, right-hand normal = S's normal
+  std::string name;                       // NAME of interface_NAME
+  dealii::types::manifold_id tag = 0;     // the manifold id of its faces
+  std::vector<dealii::Point<3>> corners;  // 3 per triangle, right-hand normal = S's normal
 
   std::size_t triangles() const { return corners.size() / 3; }
   // For Utilities::MPI::broadcast: the fully distributed ranks need the interfaces, not the mesh.
   template <class Archive>
   void serialize(Archive& archive, unsigned int /*version*/) {
-    archive & name & tag & corners;
+    archive& name& tag& corners;
   }
 };
 
@@ -73,7 +73,7 @@ void create_triangulation(const DealiiMesh& mesh, dealii::Triangulation<3>& tria
 // of `communicator`; each rank gets its cells and a layer of ghosts. Boundary and manifold ids survive.
 // Collective. Give the ranks the interfaces with Utilities::MPI::broadcast(communicator, mesh.interfaces, 0).
 dealii::TriangulationDescription::Description<3, 3> fullydistributed_description(const DealiiMesh& mesh,
-                                                                                MPI_Comm communicator);
+                                                                                 MPI_Comm communicator);
 
 // One face of S between two cells. The normal is S's: it points out of `negative` into `positive`.
 struct InterfaceCellFace {

@@ -133,10 +133,10 @@ class TriangleBVH {
             const std::vector<Eigen::AlignedBox3d>& boxes);
 
   std::vector<Node> nodes_;
-  std::vector<int> order_;                     // triangle numbers in leaf order
+  std::vector<int> order_;                       // triangle numbers in leaf order
   std::vector<Eigen::AlignedBox3d> leaf_boxes_;  // box of order_[i]
   std::vector<Triangle3> corners_;
-  std::vector<std::array<int, 3>> vertices_;   // the surface's triangles (for vertex pseudo-normals)
+  std::vector<std::array<int, 3>> vertices_;     // the surface's triangles (for vertex pseudo-normals)
   std::vector<Eigen::Vector3d> face_normals_;    // unit
   std::vector<Eigen::Vector3d> edge_normals_;    // 3 per triangle
   std::vector<Eigen::Vector3d> vertex_normals_;  // per surface point
@@ -144,8 +144,7 @@ class TriangleBVH {
 };
 
 template <class Predicate>
-bool TriangleBVH::any_triangle_overlapping(const Eigen::AlignedBox3d& box,
-                                           Predicate&& predicate) const {
+bool TriangleBVH::any_triangle_overlapping(const Eigen::AlignedBox3d& box, Predicate&& predicate) const {
   // A median split keeps the depth below log2(n) + 1, so 64 entries cannot overflow.
   std::array<int, 64> stack;
   int top = 0;

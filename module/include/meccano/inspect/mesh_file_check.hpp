@@ -29,7 +29,7 @@
 namespace meccano {
 
 struct CheckResult {
-  std::string name;                   // "conformity", "orientation", "volume", "box sides", "interface_NAME"
+  std::string name;  // "conformity", "orientation", "volume", "box sides", "interface_NAME"
   bool passed = true;
   std::string summary;                // counts or values, one line
   std::vector<std::string> problems;  // the first max_reported defects found
@@ -43,8 +43,10 @@ struct MeshFileCheck {
 
   bool passed() const;
   const CheckResult* find(const std::string& name) const;  // nullptr if that check was not run
-  std::string text() const;  // a line per check ("conformity: ok (...)" or "conformity: FAILED (...)"), problems indented
-  std::string json() const;  // {"file", "nodes", "tets", "passed", "checks": [{"name", "passed", "summary", "problems", "problem_count"}]}
+  std::string text()
+      const;  // a line per check ("conformity: ok (...)" or "conformity: FAILED (...)"), problems indented
+  std::string json()
+      const;  // {"file", "nodes", "tets", "passed", "checks": [{"name", "passed", "summary", "problems", "problem_count"}]}
 };
 
 MeshFileCheck check_msh_mesh(const MshMesh& mesh, int max_reported = 10);

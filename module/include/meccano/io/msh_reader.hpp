@@ -24,18 +24,18 @@
 namespace meccano {
 
 struct MshGroup {
-  int dimension = 0;           // 3: tets, 2: triangles
-  int tag = 0;                 // physical tag
-  std::string name;            // empty if $PhysicalNames does not name it
-  std::vector<int> elements;   // indices into MshMesh::tets or MshMesh::triangles, increasing
+  int dimension = 0;          // 3: tets, 2: triangles
+  int tag = 0;                // physical tag
+  std::string name;           // empty if $PhysicalNames does not name it
+  std::vector<int> elements;  // indices into MshMesh::tets or MshMesh::triangles, increasing
 };
 
 struct MshMesh {
   std::string source;  // the file, for messages
   std::vector<Eigen::Vector3d> points;
-  std::vector<std::uint64_t> point_tags;     // the file's node tags
-  std::vector<std::array<int, 4>> tets;      // indices into points, in the file's vertex order
-  std::vector<std::uint64_t> tet_tags;       // the file's element tags
+  std::vector<std::uint64_t> point_tags;  // the file's node tags
+  std::vector<std::array<int, 4>> tets;   // indices into points, in the file's vertex order
+  std::vector<std::uint64_t> tet_tags;    // the file's element tags
   std::vector<std::array<int, 3>> triangles;
   std::vector<std::uint64_t> triangle_tags;
   std::vector<MshGroup> groups;  // sorted by dimension, then tag

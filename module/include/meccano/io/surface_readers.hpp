@@ -51,7 +51,7 @@ TriangleSurface read_obj(const std::string& path);
 TriangleSurface read_stl(const std::string& path);  // ASCII or binary, detected from the content
 TriangleSurface read_off(const std::string& path);
 TriangleSurface read_msh_triangles(const std::string& path);  // MSH 2.2 or 4.1, ASCII or binary
-TriangleSurface read_tsurf(const std::string& path);  // GOCAD TSurf, one or more objects, of one part
+TriangleSurface read_tsurf(const std::string& path);          // GOCAD TSurf, one or more objects, of one part
 
 // Merges points closer than `tolerance` and renumbers the triangles; returns the number merged.
 int weld_vertices(TriangleSurface& surface, double tolerance);

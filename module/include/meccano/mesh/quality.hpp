@@ -60,9 +60,9 @@ inline constexpr std::array<double, 3> low_quality_thresholds{0.1, 0.2, 0.3};
 
 struct QualitySummary {
   std::int64_t tets = 0;
-  std::int64_t inverted = 0;      // tets with non-positive (or non-finite) signed volume
-  QualityStatistics meccano;      // mean ratio against the computational counterpart (the paper's)
-  QualityStatistics equilateral;  // mean ratio against the equilateral tet (Gmsh/TetGen's)
+  std::int64_t inverted = 0;                        // tets with non-positive (or non-finite) signed volume
+  QualityStatistics meccano;                        // mean ratio against the computational counterpart (the paper's)
+  QualityStatistics equilateral;                    // mean ratio against the equilateral tet (Gmsh/TetGen's)
   std::array<std::int64_t, 3> equilateral_below{};  // tets below each of low_quality_thresholds
   // Over the non-inverted tets; 0 and 180, the angles of a flat tet, when there are none.
   double min_dihedral_deg = 0, max_dihedral_deg = 0;

@@ -65,9 +65,7 @@ struct TetKind {
   // False for a tet made by a flip or edge removal: it is not a simplex of the bisection hierarchy, so it has
   // no refinement edge, type, level or meccano counterpart, and bisection refuses it.
   bool bisectable() const { return (bits & 8) == 0; }
-  static TetKind make(int type, bool negative) {
-    return {static_cast<std::uint8_t>(type | (negative ? 4 : 0))};
-  }
+  static TetKind make(int type, bool negative) { return {static_cast<std::uint8_t>(type | (negative ? 4 : 0))}; }
   // A remeshed tet, its vertices stored in positive orientation.
   static TetKind remeshed() { return {8}; }
 };
@@ -152,9 +150,7 @@ void build_neighbours(TetMesh& mesh);
 struct VertexTets {
   std::vector<int> offsets;  // size num_vertices + 1
   std::vector<TetId> tets;
-  std::span<const TetId> of(VertexId v) const {
-    return {tets.data() + offsets[v], tets.data() + offsets[v + 1]};
-  }
+  std::span<const TetId> of(VertexId v) const { return {tets.data() + offsets[v], tets.data() + offsets[v + 1]}; }
 };
 VertexTets vertex_to_tets(const TetMesh& mesh);
 

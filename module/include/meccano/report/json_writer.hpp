@@ -31,8 +31,7 @@ class JsonWriter {
   JsonWriter& value(double number);
   JsonWriter& value(bool flag) { return scalar(flag ? "true" : "false"); }
   template <std::integral T>
-    requires(!std::same_as<T, bool>)
-  JsonWriter& value(T number) {
+  requires(!std::same_as<T, bool>) JsonWriter& value(T number) {
     char buffer[24];
     const char* end = std::to_chars(buffer, buffer + sizeof buffer, number).ptr;
     return scalar({buffer, static_cast<std::size_t>(end - buffer)});

@@ -42,9 +42,9 @@
 //          removal or vertex insertion away from creases, and no flips of box faces.
 #pragma once
 
+#include <meccano/mesh/tet_mesh.hpp>
 #include <meccano/stages/projection.hpp>
 #include <meccano/stages/smoothing.hpp>
-#include <meccano/mesh/tet_mesh.hpp>
 #include <meccano/stages/volumetric_approximation.hpp>
 
 #include <cstdint>
@@ -68,10 +68,10 @@ struct ImprovementOptions {
 
 struct FlipStats {
   std::int64_t flips_2_3 = 0, flips_3_2 = 0, flips_4_4 = 0;
-  std::int64_t edge_removals = 0;                 // rings of 5 or more tets
-  std::int64_t surface_edge_flips = 0;            // edge removals inside S_M: two interface triangles flipped
-  std::int64_t crease_splits = 0;                 // S_M edges split where a crease of S crosses them
-  std::int64_t crease_moves = 0;                  // S_M nodes moved onto a crease that crossed their edge
+  std::int64_t edge_removals = 0;       // rings of 5 or more tets
+  std::int64_t surface_edge_flips = 0;  // edge removals inside S_M: two interface triangles flipped
+  std::int64_t crease_splits = 0;       // S_M edges split where a crease of S crosses them
+  std::int64_t crease_moves = 0;        // S_M nodes moved onto a crease that crossed their edge
   std::int64_t tets_removed = 0, tets_created = 0;
   std::int64_t operations() const {
     return flips_2_3 + flips_3_2 + flips_4_4 + edge_removals + surface_edge_flips + crease_splits + crease_moves;

@@ -108,8 +108,8 @@ std::array<int, 4> matching_corners(DiskView disk, const std::array<Eigen::Vecto
 class ParametricSurface {
  public:
   struct Location {
-    int triangle = -1;                  // index into the view's triangles
-    Eigen::Vector3d barycentric;        // weights of the triangle's corners: >= 0, sum 1
+    int triangle = -1;            // index into the view's triangles
+    Eigen::Vector3d barycentric;  // weights of the triangle's corners: >= 0, sum 1
   };
 
   // Throws std::invalid_argument if `parameterization` does not fit this disk (another point count, or a
@@ -129,8 +129,8 @@ class ParametricSurface {
   // arrive within max_steps (>= 0) steps (or left P by rounding).
   std::optional<Location> walk(const Eigen::Vector2d& uv, int start, int max_steps) const;
 
-  Eigen::Vector3d evaluate(const Location& location) const;          // φ(uv)
-  Eigen::Matrix<double, 3, 2> derivative(int triangle) const;        // dφ/duv, constant per triangle
+  Eigen::Vector3d evaluate(const Location& location) const;    // φ(uv)
+  Eigen::Matrix<double, 3, 2> derivative(int triangle) const;  // dφ/duv, constant per triangle
   const SquareParameterization& parameterization() const { return parameterization_; }
   int triangle_count() const { return static_cast<int>(triangles_.size()); }
 
@@ -142,11 +142,11 @@ class ParametricSurface {
   // Compact copies: only the vertices the triangles use (S_M uses few of the mesh's points).
   std::vector<Eigen::Vector3d> points_;
   std::vector<Eigen::Vector2d> uv_;
-  std::vector<std::array<int, 3>> triangles_;           // compact vertex ids, same triangle order as the view
-  std::vector<std::array<int, 3>> neighbours_;          // across the edge opposite corner k; -1 on the rim
-  int grid_size_ = 1;                                   // cells per side of P
-  std::vector<int> cell_start_;                         // CSR: triangles whose box meets cell c are
-  std::vector<int> cell_triangles_;                     // cell_triangles_[cell_start_[c] .. cell_start_[c+1])
+  std::vector<std::array<int, 3>> triangles_;   // compact vertex ids, same triangle order as the view
+  std::vector<std::array<int, 3>> neighbours_;  // across the edge opposite corner k; -1 on the rim
+  int grid_size_ = 1;                           // cells per side of P
+  std::vector<int> cell_start_;                 // CSR: triangles whose box meets cell c are
+  std::vector<int> cell_triangles_;             // cell_triangles_[cell_start_[c] .. cell_start_[c+1])
 };
 
 }  // namespace meccano

@@ -28,15 +28,15 @@
 //          options.max_tets, are InputErrors: an absurdly small l_r fails at once instead of exhausting memory.
 #pragma once
 
-#include <meccano/stages/improvement.hpp>
 #include <meccano/io/mesh_writers.hpp>
-#include <meccano/stages/projection.hpp>
 #include <meccano/mesh/quality.hpp>
-#include <meccano/stages/smoothing.hpp>
-#include <meccano/surface/triangle_surface.hpp>
-#include <meccano/stages/surface_approximation.hpp>
 #include <meccano/mesh/tet_mesh.hpp>
+#include <meccano/stages/improvement.hpp>
+#include <meccano/stages/projection.hpp>
+#include <meccano/stages/smoothing.hpp>
+#include <meccano/stages/surface_approximation.hpp>
 #include <meccano/stages/volumetric_approximation.hpp>
+#include <meccano/surface/triangle_surface.hpp>
 
 #include <array>
 #include <cstdint>
@@ -76,17 +76,17 @@ struct InsertionOptions {
   // After SUS: lift the worst tets by smoothing and flips (topology), by smoothing alone (smooth: keeps
   // every tet in the bisection hierarchy, for callers that refine the result further), or not at all.
   Improvement improve = Improvement::topology;
-  ImprovementOptions improvement;            // its `topology` is set from `improve`
-  int threads = 0;                            // OpenMP threads for this call; 0 = OpenMP's default
-  std::int64_t max_tets = default_max_tets;    // refuse when estimate_tets exceeds it
-  int finer_retries = 2;                      // times a failing surface may be retried at a finer l_r
+  ImprovementOptions improvement;                    // its `topology` is set from `improve`
+  int threads = 0;                                   // OpenMP threads for this call; 0 = OpenMP's default
+  std::int64_t max_tets = default_max_tets;          // refuse when estimate_tets exceeds it
+  int finer_retries = 2;                             // times a failing surface may be retried at a finer l_r
   std::function<void(const std::string&)> progress;  // one line per stage and per smoothing sweep, with counts
 };
 
 struct SurfaceInsertion {
   std::string name;
   double resolution = 0.0;  // the l_r it was inserted at: options.resolution, or less after finer retries
-  TetRegion volumetric;  // V_M, one flag per tet of the final mesh
+  TetRegion volumetric;     // V_M, one flag per tet of the final mesh
   VolumetricStats volumetric_stats;
   double volumetric_seconds = 0.0;
   HealingStats healing_stats;  // of the last healing of this surface's S_M
@@ -100,17 +100,18 @@ struct InsertionResult {
   std::vector<SurfaceInsertion> surfaces;
   SmoothingStats smoothing;
   double smoothing_seconds = 0.0;
-  QualitySummary quality_before_smoothing;  // right after projection (tets may be inverted)
+  QualitySummary quality_before_smoothing;      // right after projection (tets may be inverted)
   std::optional<ImprovementStats> improvement;  // when the improvement ran
   double improvement_seconds = 0.0;
-  QualitySummary quality_after_smoothing;   // of the result: after SUS and the improvement
-  double seconds = 0.0;                     // the whole insertion
-  std::int64_t estimated_tets = 0;          // estimate_tets before any refinement, for the l_r asked
-  std::string side_retry;  // why the insertion was run again with S_M on the other side (empty if not)
+  QualitySummary quality_after_smoothing;  // of the result: after SUS and the improvement
+  double seconds = 0.0;                    // the whole insertion
+  std::int64_t estimated_tets = 0;         // estimate_tets before any refinement, for the l_r asked
+  std::string side_retry;                  // why the insertion was run again with S_M on the other side (empty if not)
   std::vector<std::string> finer_retries;  // why it was run again with finer l_r for some surfaces, in order
 };
 
-InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options);
+InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces,
+                                const InsertionOptions& options);
 
 // `domain`, the box sides, and `interface_NAME` for every surface's S_M (once built), oriented like the
 // surface; at the inspection stages (last_stage before smoothing) also `volumetric_NAME` for every

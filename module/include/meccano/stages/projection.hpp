@@ -17,12 +17,12 @@
 //          one-to-one).
 #pragma once
 
-#include <meccano/surface/creases.hpp>
 #include <meccano/geometry/geometry.hpp>
-#include <meccano/stages/parameterization.hpp>
-#include <meccano/surface/triangle_surface.hpp>
 #include <meccano/mesh/tet_mesh.hpp>
+#include <meccano/stages/parameterization.hpp>
 #include <meccano/stages/volumetric_approximation.hpp>
+#include <meccano/surface/creases.hpp>
+#include <meccano/surface/triangle_surface.hpp>
 
 #include <array>
 #include <memory>
@@ -30,11 +30,11 @@
 namespace meccano {
 
 struct ProjectionStats {
-  std::int64_t nodes = 0;              // S_M nodes moved
+  std::int64_t nodes = 0;  // S_M nodes moved
   std::int64_t rim_nodes = 0;
-  double largest_move = 0.0;           // physical distance, x_i - x_Mi
-  double largest_distance_after = 0.0; // of a moved node to S (round-off)
-  std::int64_t inverted_tets = 0;      // after the move, before smoothing
+  double largest_move = 0.0;            // physical distance, x_i - x_Mi
+  double largest_distance_after = 0.0;  // of a moved node to S (round-off)
+  std::int64_t inverted_tets = 0;       // after the move, before smoothing
   CreaseStats creases;
 };
 

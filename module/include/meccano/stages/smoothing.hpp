@@ -48,9 +48,9 @@
 //          not present that mesh as a result.
 #pragma once
 
-#include <meccano/stages/projection.hpp>
 #include <meccano/mesh/quality.hpp>
 #include <meccano/mesh/tet_mesh.hpp>
+#include <meccano/stages/projection.hpp>
 
 #include <cstdint>
 #include <functional>
@@ -63,13 +63,13 @@ enum class SmoothingTarget { meccano, equilateral };
 enum class SmoothingMode { whole_mesh, band };
 
 struct SweepRecord {
-  std::int64_t inverted = 0;        // tets with σ <= 0 after the sweep
+  std::int64_t inverted = 0;  // tets with σ <= 0 after the sweep
   std::int64_t nodes_optimised = 0;
-  double min_quality = 0.0;         // 1/η against the target, over the tets of free nodes
+  double min_quality = 0.0;  // 1/η against the target, over the tets of free nodes
   double mean_quality = 0.0;
-  double power = 1.0;               // the exponent p the sweep minimised Σ η*^p with
+  double power = 1.0;                                 // the exponent p the sweep minimised Σ η*^p with
   SmoothingTarget target = SmoothingTarget::meccano;  // the target of the sweep's W
-  double objective = 0.0;           // Σ η^p over those tets after the sweep
+  double objective = 0.0;                             // Σ η^p over those tets after the sweep
   double seconds = 0.0;
 };
 
@@ -80,7 +80,7 @@ struct SmoothingOptions {
   int max_sweeps = 100;
   int fallback_sweeps = 20;  // tangled sweeps towards the meccano target before the equilateral fallback; 0: never
   int smoothing_sweeps = 20;
-  int stalled_sweeps = 20;   // tangled sweeps without a new fewest-inverted count before giving up (fallback done)
+  int stalled_sweeps = 20;  // tangled sweeps without a new fewest-inverted count before giving up (fallback done)
   double tolerance = 1e-3;
   double power = 4.0;    // p of Σ η*^p once untangled; 1 is the paper's objective
   int newton_steps = 2;  // per node and sweep
@@ -90,17 +90,17 @@ struct SmoothingOptions {
 };
 
 struct SmoothingStats {
-  std::int64_t inner_nodes = 0;     // free nodes by freedom
-  std::int64_t box_nodes = 0;       // on a box side or edge
-  std::int64_t surface_nodes = 0;   // S_M nodes inside the rim
-  std::int64_t rim_nodes = 0;       // S_M rim nodes, corners of P excluded
-  std::int64_t crease_nodes = 0;    // S_M nodes on a crease line of S (stages/projection.hpp)
-  std::int64_t active_tets = 0;     // tets with a free node
+  std::int64_t inner_nodes = 0;    // free nodes by freedom
+  std::int64_t box_nodes = 0;      // on a box side or edge
+  std::int64_t surface_nodes = 0;  // S_M nodes inside the rim
+  std::int64_t rim_nodes = 0;      // S_M rim nodes, corners of P excluded
+  std::int64_t crease_nodes = 0;   // S_M nodes on a crease line of S (stages/projection.hpp)
+  std::int64_t active_tets = 0;    // tets with a free node
   int colours = 0;
   std::int64_t inverted_before = 0;
   std::int64_t inverted_after = 0;
-  int untangling_sweeps = 0;        // sweeps until no tet was inverted (0 if none was)
-  int fallback_sweep = 0;           // the first sweep towards the equilateral fallback target (0: none)
+  int untangling_sweeps = 0;  // sweeps until no tet was inverted (0 if none was)
+  int fallback_sweep = 0;     // the first sweep towards the equilateral fallback target (0: none)
   std::vector<SweepRecord> sweeps;
   bool untangled() const { return inverted_after == 0; }
 };
@@ -116,6 +116,7 @@ struct Distortion {
 Distortion regularised_distortion(const TetPoints& physical, const Eigen::Matrix3d& target_inverse, int vertex,
                                   double delta);
 
-SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces, const SmoothingOptions& options = {});
+SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
+                           const SmoothingOptions& options = {});
 
 }  // namespace meccano

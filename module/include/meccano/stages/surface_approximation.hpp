@@ -48,9 +48,9 @@
 
 #include <meccano/geometry/geometry.hpp>
 #include <meccano/io/mesh_writers.hpp>
-#include <meccano/surface/triangle_surface.hpp>
 #include <meccano/mesh/tet_mesh.hpp>
 #include <meccano/stages/volumetric_approximation.hpp>
+#include <meccano/surface/triangle_surface.hpp>
 
 #include <array>
 #include <string>
@@ -68,25 +68,25 @@ struct SurfaceApproximationOptions {
 };
 
 struct HealingStats {
-  int side = 0;       // +1 or -1: the side of S that S_M lies on
-  int attempts = 0;   // sides tried
+  int side = 0;      // +1 or -1: the side of S that S_M lies on
+  int attempts = 0;  // sides tried
   int passes = 0;
   std::int64_t initial_faces = 0;
-  std::int64_t stray_faces = 0;        // removed by the component clean-up
-  std::int64_t hole_faces = 0;         // added by hole filling
-  std::int64_t extension_faces = 0;    // added to make the rim axis-parallel
+  std::int64_t stray_faces = 0;      // removed by the component clean-up
+  std::int64_t hole_faces = 0;       // added by hole filling
+  std::int64_t extension_faces = 0;  // added to make the rim axis-parallel
   std::int64_t corbels = 0;
   std::int64_t reflex_corners_filled = 0;  // reflex rim corners filled with the squares S_M lacked
-  std::int64_t filled_faces = 0;        // faces added by those fills
-  std::int64_t reflex_corners_left = 0;  // reflex rim corners that could not be filled
+  std::int64_t filled_faces = 0;           // faces added by those fills
+  std::int64_t reflex_corners_left = 0;    // reflex rim corners that could not be filled
   std::int64_t tets_with_two_faces = 0;
   std::int64_t triangles_with_two_rim_edges = 0;
   std::int64_t cross_surface_edges = 0;
   std::int64_t dividing_edges = 0;
-  std::int64_t chord_edges = 0;        // beyond the paper: off S_M, between two of its nodes
-  std::int64_t faces = 0;              // S_M faces at the end
+  std::int64_t chord_edges = 0;  // beyond the paper: off S_M, between two of its nodes
+  std::int64_t faces = 0;        // S_M faces at the end
   std::int64_t rim_nodes = 0;
-  std::string first_side_failure;      // why the first side was abandoned, if it was
+  std::string first_side_failure;  // why the first side was abandoned, if it was
 };
 
 // Builds and heals S_M of surface `index` and tags its faces interface_tag(index).
@@ -124,8 +124,8 @@ struct SurfaceApproximationCheck {
   }
   bool healed() const {
     return is_disk() && oblique_rim_edges == 0 && corbels == 0 && tets_with_two_faces == 0 &&
-           triangles_with_two_rim_edges == 0 && cross_surface_edges == 0 &&
-           dividing_edges == 0 && chord_edges == 0 && nodes_on_box_or_other_surface == 0;
+           triangles_with_two_rim_edges == 0 && cross_surface_edges == 0 && dividing_edges == 0 && chord_edges == 0 &&
+           nodes_on_box_or_other_surface == 0;
   }
   std::string describe() const;
 };

@@ -38,8 +38,8 @@
 //          only by reaching beyond the band (the message names where).
 #pragma once
 
-#include <meccano/mesh/bisection.hpp>
 #include <meccano/geometry/geometry.hpp>
+#include <meccano/mesh/bisection.hpp>
 #include <meccano/mesh/tet_mesh.hpp>
 
 #include <cstdint>
@@ -67,20 +67,20 @@ struct VolumetricOptions {
 };
 
 struct VolumetricStats {
-  int level = 0;                       // L: the bisection level of V_M's tets (level_for_resolution)
-  double reach = 0.0;                  // growth_reach: how far from S V_M's nodes may lie
+  int level = 0;       // L: the bisection level of V_M's tets (level_for_resolution)
+  double reach = 0.0;  // growth_reach: how far from S V_M's nodes may lie
   int refinement_passes = 0;
   std::int64_t bisections = 0;
   std::int64_t intersection_tests = 0;
   std::int64_t tets_intersecting = 0;  // tets of V_M after refinement, before growth
   std::int64_t euler_node_stars = 0;   // nodes whose star was added by the link test
   std::int64_t cavity_tets = 0;
-  std::int64_t axis_tets = 0;          // tets added to make the boundary axis-parallel
-  int thickening_layers = 0;           // layers added to close handles the link test cannot see
-  int growth_refinements = 0;          // times the growth bisected tets (coarse, or with nodes beyond l_r)
-  std::int64_t band_tets = 0;          // tets of the finest growth level added with a node beyond the reach
+  std::int64_t axis_tets = 0;  // tets added to make the boundary axis-parallel
+  int thickening_layers = 0;   // layers added to close handles the link test cannot see
+  int growth_refinements = 0;  // times the growth bisected tets (coarse, or with nodes beyond l_r)
+  std::int64_t band_tets = 0;  // tets of the finest growth level added with a node beyond the reach
   int growth_passes = 0;
-  std::int64_t tets = 0;               // tets of V_M at the end
+  std::int64_t tets = 0;  // tets of V_M at the end
 };
 
 // Runs steps 1-3. `other_regions` (e.g. the V_M of surfaces inserted before) follow the refinement.
@@ -95,11 +95,11 @@ void grow_into_ball(TetMesh& mesh, TetRegion& region, const VolumetricOptions& o
 struct BallCheck {
   bool nonempty = false;
   bool connected = false;
-  std::int64_t non_disk_links = 0;        // boundary nodes whose link in the region is not a disk
-  std::int64_t non_manifold_edges = 0;    // boundary edges not in exactly two boundary faces
+  std::int64_t non_disk_links = 0;      // boundary nodes whose link in the region is not a disk
+  std::int64_t non_manifold_edges = 0;  // boundary edges not in exactly two boundary faces
   int boundary_components = 0;
-  std::int64_t boundary_euler = 0;        // V - E + F of the boundary surface
-  std::int64_t non_axis_faces = 0;        // boundary faces not on a coordinate plane
+  std::int64_t boundary_euler = 0;  // V - E + F of the boundary surface
+  std::int64_t non_axis_faces = 0;  // boundary faces not on a coordinate plane
   bool is_ball() const {
     return nonempty && connected && non_disk_links == 0 && non_manifold_edges == 0 && boundary_components == 1 &&
            boundary_euler == 2;

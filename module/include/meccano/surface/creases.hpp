@@ -47,10 +47,10 @@ inline constexpr double default_crease_angle = 12.0;
 
 // A polyline of P along crease edges of S, parameterized by arc length in P.
 struct CreaseLine {
-  std::vector<int> vertices;            // of S, in order
-  std::vector<Eigen::Vector2d> uv;      // their parameters
-  std::vector<double> arc;              // arc length in P from the first vertex; arc.back() = length
-  double angle = 0.0;                   // the largest crease angle along it, degrees
+  std::vector<int> vertices;        // of S, in order
+  std::vector<Eigen::Vector2d> uv;  // their parameters
+  std::vector<double> arc;          // arc length in P from the first vertex; arc.back() = length
+  double angle = 0.0;               // the largest crease angle along it, degrees
 
   double length() const { return arc.back(); }
   Eigen::Vector2d at(double s) const;         // the point at arc length s, clamped to [0, length]
@@ -59,23 +59,22 @@ struct CreaseLine {
 };
 
 // The crease polylines of S. `uv` holds S's vertices' parameters; `angle` in degrees (> 0).
-std::vector<CreaseLine> crease_lines(const TriangleSurface& surface, std::span<const Eigen::Vector2d> uv,
-                                     double angle);
+std::vector<CreaseLine> crease_lines(const TriangleSurface& surface, std::span<const Eigen::Vector2d> uv, double angle);
 
 struct CreaseStats {
-  std::int64_t lines = 0;           // crease lines of S
-  std::int64_t crossings = 0;       // S_M edges they cross
-  std::int64_t nodes = 0;           // S_M nodes placed on a line
-  std::int64_t refused = 0;         // path nodes left off their line (a fold, or a crushed triangle)
-  std::int64_t straddling = 0;      // S_M edges a line still crosses between their nodes after snapping
-  double sharpest = 0.0;            // the largest crease angle of S, degrees (0 without lines)
+  std::int64_t lines = 0;       // crease lines of S
+  std::int64_t crossings = 0;   // S_M edges they cross
+  std::int64_t nodes = 0;       // S_M nodes placed on a line
+  std::int64_t refused = 0;     // path nodes left off their line (a fold, or a crushed triangle)
+  std::int64_t straddling = 0;  // S_M edges a line still crosses between their nodes after snapping
+  double sharpest = 0.0;        // the largest crease angle of S, degrees (0 without lines)
 };
 
 // Which S_M nodes lie on a crease line, and where on it.
 struct CreaseNodes {
   std::vector<CreaseLine> lines;
-  std::vector<int> line_of;           // per S_M node: its line, or -1
-  std::vector<double> parameter;      // per S_M node on a line: its arc-length parameter
+  std::vector<int> line_of;       // per S_M node: its line, or -1
+  std::vector<double> parameter;  // per S_M node on a line: its arc-length parameter
   CreaseStats stats;
 };
 
@@ -91,7 +90,8 @@ struct CreaseCrossing {
 
 // Every such crossing of `creases`' lines with the edges of S_M's `triangles` at parameters `uv`, in the
 // order of the lines and along each line.
-std::vector<CreaseCrossing> straddling_crossings(const CreaseNodes& creases, std::span<const std::array<int, 3>> triangles,
+std::vector<CreaseCrossing> straddling_crossings(const CreaseNodes& creases,
+                                                 std::span<const std::array<int, 3>> triangles,
                                                  std::span<const Eigen::Vector2d> uv);
 
 // Snaps S_M's nodes onto the crease lines (see the header comment); `uv` (per S_M node) is updated.

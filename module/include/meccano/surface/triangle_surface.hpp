@@ -12,8 +12,8 @@
 namespace meccano {
 
 struct TriangleSurface {
-  std::string name;         // used in output group names, e.g. interface_NAME
-  std::string source;       // file the surface came from (for messages); empty when built in code
+  std::string name;    // used in output group names, e.g. interface_NAME
+  std::string source;  // file the surface came from (for messages); empty when built in code
   std::vector<Eigen::Vector3d> points;
   std::vector<std::array<int, 3>> triangles;
 };

@@ -30,7 +30,8 @@ InsertionResult insert_until_projection(std::span<const TriangleSurface> surface
 TriangleSurface projected_interface(const InsertionResult& result, int s) {
   TriangleSurface projected;
   const SurfaceInsertion& inserted = result.surfaces[s];
-  const InterfaceFaces faces = interface_faces(result.mesh, inserted.volumetric, s, inserted.healing_stats.side);
+  const ApproximationFaces faces =
+      approximation_faces(result.mesh, inserted.volumetric, s, inserted.healing_stats.side);
   std::vector<int> local(result.mesh.points.size(), -1);
   for (const auto& t : faces.triangles) {
     std::array<int, 3> triangle{};

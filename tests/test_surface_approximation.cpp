@@ -57,7 +57,7 @@ TEST_P(SurfaceApproximationOn, IsAHealedDiskCloseToSAndOrientedLikeIt) {
     // Nodes within V_M's reach of S (growth_band times it where V_M's growth crossed the offset at the
     // reach), and the faces' normals agree with S's nearby (area-weighted cosine).
     const double reach = growth_reach(mesh.meccano, c.resolution);
-    const InterfaceFaces faces = interface_faces(mesh, regions[s], s, healing[s].side);
+    const ApproximationFaces faces = approximation_faces(mesh, regions[s], s, healing[s].side);
     ASSERT_EQ(static_cast<std::int64_t>(faces.triangles.size()), check.faces);
     double agreement = 0, area = 0;
     for (const auto& t : faces.triangles) {

@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
     const int side = meccano::approximate_surface(mesh, region, surface, tree, 0).side;
     const double approximation_seconds = seconds_since(start);
 
-    const meccano::InterfaceFaces faces = meccano::interface_faces(mesh, region, 0, side);
+    const meccano::ApproximationFaces faces = meccano::approximation_faces(mesh, region, 0, side);
     const std::vector<std::array<int, 3>> triangles(faces.triangles.begin(), faces.triangles.end());
     const double surface_parameterization_seconds = parameterization_seconds(surface);
     const double approximation_parameterization_seconds = parameterization_seconds({mesh.points, triangles});

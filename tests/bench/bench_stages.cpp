@@ -118,7 +118,7 @@ void measure_healing(double resolution) {
     const auto start = std::chrono::steady_clock::now();
     const meccano::HealingStats h = meccano::approximate_surface(mesh, region, patch, patch_tree, 0);
     const double ms = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() * 1e3;
-    const auto faces = meccano::interface_faces(mesh, region, 0, h.side);
+    const auto faces = meccano::approximation_faces(mesh, region, 0, h.side);
     double largest = 0;
     for (const auto& t : faces.triangles)
       for (meccano::VertexId v : t)
@@ -170,7 +170,7 @@ void measure_projection(const meccano::TriangleSurface& example, const meccano::
     const double ms = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() * 1e3;
     meccano::TriangleSurface projected;
     projected.points = mesh.points;
-    for (const auto& t : meccano::interface_faces(mesh, region, 0, h.side).triangles)
+    for (const auto& t : meccano::approximation_faces(mesh, region, 0, h.side).triangles)
       projected.triangles.push_back({t[0], t[1], t[2]});
     const meccano::TriangleBVH projected_tree(projected);
     const double hausdorff = hausdorff_distance(example, tree, projected, projected_tree);

@@ -619,7 +619,7 @@ MeshGroups output_groups(const InsertionResult& result, Stage last_stage) {
     if (inserted.healing_stats.side != 0)
       groups.surfaces.push_back(
           {"interface_" + inserted.name, interface_tag(s),
-           interface_faces(result.mesh, inserted.volumetric, s, inserted.healing_stats.side).faces});
+           approximation_faces(result.mesh, inserted.volumetric, s, inserted.healing_stats.side).faces});
   }
   return groups;
 }
@@ -630,7 +630,7 @@ std::vector<SurfaceInterface> surface_interfaces(const InsertionResult& result) 
   for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s) {
     const SurfaceInsertion& inserted = result.surfaces[s];
     if (inserted.healing_stats.side == 0) continue;
-    const InterfaceFaces oriented = interface_faces(mesh, inserted.volumetric, s, inserted.healing_stats.side);
+    const ApproximationFaces oriented = approximation_faces(mesh, inserted.volumetric, s, inserted.healing_stats.side);
     SurfaceInterface& interface = interfaces.emplace_back();
     interface.name = inserted.name;
     interface.tag = interface_tag(s);

@@ -26,7 +26,7 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
   // of staying near 0.06, and half as many tets are inverted. The remaining 0.2 keeps apart nodes
   // beyond the rim of S, which share their closest point. Any positive weights keep the map one-to-one.
   constexpr double kept_offset = 0.2;
-  const InterfaceFaces faces = interface_faces(mesh, volumetric, index, side);
+  const ApproximationFaces faces = approximation_faces(mesh, volumetric, index, side);
   std::vector<std::array<int, 3>> triangles(faces.triangles.begin(), faces.triangles.end());
   std::vector<Eigen::Vector3d> pulled = mesh.points;
   for (const auto& t : triangles)

@@ -722,8 +722,8 @@ HealingStats approximate_surface(TetMesh& mesh, TetRegion& volumetric, const Tri
   throw MeshingError("the surface approximation S_M could not be healed into a disk (" + failures + ")");
 }
 
-InterfaceFaces interface_faces(const TetMesh& mesh, const TetRegion& volumetric, int index, int side) {
-  InterfaceFaces result;
+ApproximationFaces approximation_faces(const TetMesh& mesh, const TetRegion& volumetric, int index, int side) {
+  ApproximationFaces result;
   const Interface s = read_interface(mesh, volumetric, interface_tag(index));
   for (const FaceRef& f : s.faces) {
     // The V_M tet's outward normal points away from V_M, i.e. to the side S_M lies on.

@@ -97,11 +97,11 @@ HealingStats approximate_surface(TetMesh& mesh, TetRegion& volumetric, const Tri
 // The faces of S_M (tag interface_tag(index)), each once, oriented like S: the normal (right-hand rule on
 // the vertex order) points to the side of S that S_M lies on when side = +1, and away from it when
 // side = -1, i.e. it always agrees with S's normals. `volumetric` tells the two tets of a face apart.
-struct InterfaceFaces {
+struct ApproximationFaces {
   std::vector<std::array<VertexId, 3>> triangles;
   std::vector<FaceRef> faces;  // the tet whose outward face normal is the triangle's normal
 };
-InterfaceFaces interface_faces(const TetMesh& mesh, const TetRegion& volumetric, int index, int side);
+ApproximationFaces approximation_faces(const TetMesh& mesh, const TetRegion& volumetric, int index, int side);
 
 struct SurfaceApproximationCheck {
   std::int64_t faces = 0;

@@ -121,44 +121,28 @@ void write_report(const ReferenceRun& run, const std::function<void(JsonWriter&)
   JsonWriter json;
   json.begin_object().key("tool").value(run.tool);
   tool_keys(json);
-  json.key("size")
-      .value(run.size)
-      .key("tets")
-      .value(run.mesh.tets)
-      .key("nodes")
-      .value(run.mesh.nodes)
-      .key("inverted")
-      .value(run.mesh.inverted)
-      .key("max_tet_volume")
-      .value(run.mesh.max_volume)
-      .key("interface_triangles")
-      .begin_object();
+  json.key("size").value(run.size);
+  json.key("tets").value(run.mesh.tets);
+  json.key("nodes").value(run.mesh.nodes);
+  json.key("inverted").value(run.mesh.inverted);
+  json.key("max_tet_volume").value(run.mesh.max_volume);
+  json.key("interface_triangles").begin_object();
   for (const auto& [name, count] : run.interface_triangles) json.key(name).value(count);
-  json.end_object()
-      .key("seconds")
-      .begin_object()
-      .key("meshing")
-      .value(run.meshing_seconds)
-      .key("total")
-      .value(total_seconds)
-      .end_object()
-      .key("quality")
-      .begin_object()
-      .key("equilateral")
-      .begin_object()
-      .key("min")
-      .value(run.mesh.min_mean_ratio)
-      .key("mean")
-      .value(run.mesh.mean_mean_ratio)
-      .key("std")
-      .value(run.mesh.std_mean_ratio)
-      .end_object()
-      .key("min_dihedral_deg")
-      .value(run.mesh.min_dihedral_deg)
-      .key("max_dihedral_deg")
-      .value(run.mesh.max_dihedral_deg)
-      .end_object()
-      .end_object();
+  json.end_object();
+  json.key("seconds").begin_object();
+  json.key("meshing").value(run.meshing_seconds);
+  json.key("total").value(total_seconds);
+  json.end_object();
+  json.key("quality").begin_object();
+  json.key("equilateral").begin_object();
+  json.key("min").value(run.mesh.min_mean_ratio);
+  json.key("mean").value(run.mesh.mean_mean_ratio);
+  json.key("std").value(run.mesh.std_mean_ratio);
+  json.end_object();
+  json.key("min_dihedral_deg").value(run.mesh.min_dihedral_deg);
+  json.key("max_dihedral_deg").value(run.mesh.max_dihedral_deg);
+  json.end_object();
+  json.end_object();
   write_file_atomically(path, [&](std::ostream& out) { out << json.str(); });
 }
 

@@ -276,18 +276,16 @@ void write_report(const meccano::reference::ReferenceRun& run, const Options& op
   meccano::reference::write_report(
       run,
       [&](meccano::JsonWriter& json) {
-    json.key("gmsh_version")
-        .value(version)
-        .key("algorithm")
-        .value(options.algorithm == Algorithm::hxt ? "hxt" : "delaunay")
-        .key("threads")
-        .value(options.threads);
-    if (options.size_field)
-      json.key("size_near_surface")
-          .value(options.size_field->near_surface)
-          .key("size_distance")
-          .value(options.size_field->distance);
-    else json.key("size_near_surface").null().key("size_distance").null();
+    json.key("gmsh_version").value(version);
+    json.key("algorithm").value(options.algorithm == Algorithm::hxt ? "hxt" : "delaunay");
+    json.key("threads").value(options.threads);
+    if (options.size_field) {
+      json.key("size_near_surface").value(options.size_field->near_surface);
+      json.key("size_distance").value(options.size_field->distance);
+    } else {
+      json.key("size_near_surface").null();
+      json.key("size_distance").null();
+    }
       },
       total_seconds, path);
 }

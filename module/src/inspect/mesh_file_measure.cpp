@@ -198,13 +198,11 @@ std::string MeshMeasure::json() const {
     if (i.accuracy) {
       const SurfaceAccuracy& a = *i.accuracy;
       json.key("surface").value(a.surface);
-      json.key("node_distance")
-          .begin_object()
-          .key("max")
-          .value(a.node_distance_max)
-          .key("mean")
-          .value(a.node_distance_mean);
-      json.end_object().key("hausdorff").value(a.hausdorff);
+      json.key("node_distance").begin_object();
+      json.key("max").value(a.node_distance_max);
+      json.key("mean").value(a.node_distance_mean);
+      json.end_object();
+      json.key("hausdorff").value(a.hausdorff);
       json.key("normal_deviation_deg").begin_object().key("max").value(a.normal_deviation_max_deg);
       json.key("mean").value(a.normal_deviation_mean_deg).end_object();
       json.key("flipped_faces").value(a.flipped_faces).key("area_ratio").value(a.area_ratio);

@@ -37,10 +37,8 @@ void write_surface(JsonWriter& json, const SurfaceInsertion& inserted, Stage las
     json.key("approximation").begin_object();
     json.key("side").value(h.side).key("healing_passes").value(h.passes).key("faces").value(h.faces);
     json.key("rim_nodes").value(h.rim_nodes).key("corbels").value(h.corbels);
-    json.key("reflex_corners_filled")
-        .value(h.reflex_corners_filled)
-        .key("reflex_corners_left")
-        .value(h.reflex_corners_left);
+    json.key("reflex_corners_filled").value(h.reflex_corners_filled);
+    json.key("reflex_corners_left").value(h.reflex_corners_left);
     json.key("tets_with_two_faces").value(h.tets_with_two_faces);
     json.key("triangles_with_two_rim_edges").value(h.triangles_with_two_rim_edges);
     json.key("cross_surface_edges").value(h.cross_surface_edges).key("dividing_edges").value(h.dividing_edges);
@@ -87,10 +85,8 @@ void write_smoothing(JsonWriter& json, const SmoothingStats& s, double seconds) 
 void write_improvement(JsonWriter& json, const ImprovementStats& s, double seconds) {
   json.key("improvement").begin_object();
   json.key("passes").value(s.passes);
-  json.key("tets_below_threshold_before")
-      .value(s.tets_below_before)
-      .key("tets_below_threshold_after")
-      .value(s.tets_below_after);
+  json.key("tets_below_threshold_before").value(s.tets_below_before);
+  json.key("tets_below_threshold_after").value(s.tets_below_after);
   json.key("node_updates").value(s.node_updates).key("nodes_moved").value(s.nodes_moved);
   json.key("min_equilateral_quality_before").value(s.min_quality_before);
   json.key("min_equilateral_quality_after").value(s.min_quality_after);
@@ -98,13 +94,10 @@ void write_improvement(JsonWriter& json, const ImprovementStats& s, double secon
   json.key("operations").begin_object();
   json.key("flips_2_3").value(s.flips.flips_2_3).key("flips_3_2").value(s.flips.flips_3_2);
   json.key("flips_4_4").value(s.flips.flips_4_4).key("edge_removals").value(s.flips.edge_removals);
-  json.key("surface_edge_flips")
-      .value(s.flips.surface_edge_flips)
-      .key("crease_splits")
-      .value(s.flips.crease_splits)
-      .key("crease_moves")
-      .value(s.flips.crease_moves)
-      .end_object();
+  json.key("surface_edge_flips").value(s.flips.surface_edge_flips);
+  json.key("crease_splits").value(s.flips.crease_splits);
+  json.key("crease_moves").value(s.flips.crease_moves);
+  json.end_object();
   json.key("tets_removed").value(s.flips.tets_removed).key("tets_created").value(s.flips.tets_created);
   json.key("remeshed_tets").value(s.remeshed_tets);
   json.key("seconds").value(seconds).end_object();

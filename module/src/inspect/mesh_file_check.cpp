@@ -213,6 +213,7 @@ class MeshFileChecker {
     detail::TopologyScratch scratch;
     std::vector<VertexId> vertices;
     const detail::TriangleTopology topology = detail::triangle_topology(triangles, scratch, &vertices);
+    const int boundary_loops = detail::count_boundary_loops(scratch);
     // An edge of a consistently oriented surface is run once in each direction.
     std::vector<std::pair<VertexId, VertexId>> directed;
     for (const auto& t : triangles)
@@ -226,7 +227,7 @@ class MeshFileChecker {
     if (topology.overloaded_edges > 0) problem(check, topology.overloaded_edges, " edges in more than two triangles");
     if (topology.pinched_vertices > 0) problem(check, topology.pinched_vertices, " pinched vertices");
     if (topology.euler() != 1) problem(check, "Euler characteristic ", topology.euler(), " (a disk has 1)");
-    if (topology.boundary_loops != 1) problem(check, topology.boundary_loops, " boundary loops (a disk has one)");
+    if (boundary_loops != 1) problem(check, boundary_loops, " boundary loops (a disk has one)");
     if (flipped > 0) problem(check, flipped, " edges run twice in the same direction (inconsistent orientation)");
     // Not a defect of the mesh, but a fault solver that splits the interface's nodes needs a node off the
     // interface in every tet: counted, not failed (a coarse mesh that keeps the surface may have some).
@@ -234,8 +235,7 @@ class MeshFileChecker {
     const auto lying_on = std::ranges::count_if(
         mesh_.tets, [&](const std::array<int, 4>& tet) { return std::ranges::all_of(tet, on_interface); });
     check.summary = std::to_string(triangles.size()) + " triangles, Euler characteristic " +
-                    std::to_string(topology.euler()) + ", " + std::to_string(topology.boundary_loops) +
-                    " boundary loop(s)";
+                    std::to_string(topology.euler()) + ", " + std::to_string(boundary_loops) + " boundary loop(s)";
     if (lying_on > 0) check.summary += ", " + std::to_string(lying_on) + " tets with all four nodes on it";
     return check;
   }

@@ -53,15 +53,15 @@ class UnionFind {
 };
 
 // Counts that decide what a set of triangles is topologically (a disk, a sphere, something else). It is
-// a disk when it is one component, no edge is overloaded, no vertex pinched, the boundary is one loop
-// and the Euler characteristic is 1; each caller reports the counts that fail in its own words.
+// a disk when it is one component, no edge is overloaded, no vertex pinched, it has boundary edges and
+// the Euler characteristic is 1 (then its boundary is one loop: count_boundary_loops, for messages);
+// each caller reports the counts that fail in its own words.
 struct TriangleTopology {
   std::int64_t vertices = 0, edges = 0, faces = 0;
   std::int64_t boundary_edges = 0;    // in one triangle
   std::int64_t overloaded_edges = 0;  // in more than two
   std::int64_t pinched_vertices = 0;  // whose triangles form more than one open fan
   int components = 0;                 // joined across shared edges
-  int boundary_loops = 0;             // components of the boundary edges
   std::int64_t euler() const { return vertices - edges + faces; }
 };
 
@@ -122,6 +122,15 @@ inline TriangleTopology triangle_topology(std::span<const std::array<VertexId, 3
     distinct.push_back(fans[i].first);
     i = j;
   }
+  if (vertices) *vertices = distinct;
+  return t;
+}
+
+// The components of the boundary edges of the triangles of the last triangle_topology call on `scratch`.
+// Apart from it because the hot caller (V_M's node-link test) need not count them: a connected manifold
+// with boundary edges and Euler characteristic 1 has one boundary loop.
+inline int count_boundary_loops(TopologyScratch& scratch) {
+  const auto& distinct = scratch.vertices;
   auto index = [&](VertexId v) {
     return static_cast<std::size_t>(std::lower_bound(distinct.begin(), distinct.end(), v) - distinct.begin());
   };
@@ -131,10 +140,9 @@ inline TriangleTopology triangle_topology(std::span<const std::array<VertexId, 3
     scratch.loops.join(index(e.first), index(e.second));
     scratch.on_boundary[index(e.first)] = scratch.on_boundary[index(e.second)] = 1;
   }
-  for (std::size_t v = 0; v < distinct.size(); ++v)
-    t.boundary_loops += scratch.on_boundary[v] && scratch.loops.find(v) == v;
-  if (vertices) *vertices = distinct;
-  return t;
+  int loops = 0;
+  for (std::size_t v = 0; v < distinct.size(); ++v) loops += scratch.on_boundary[v] && scratch.loops.find(v) == v;
+  return loops;
 }
 
 }  // namespace meccano::detail

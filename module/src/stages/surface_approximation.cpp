@@ -424,7 +424,7 @@ void check_disk(const TetMesh& mesh, const Interface& s, SurfaceApproximationChe
   c.non_manifold_edges = topology.overloaded_edges;
   c.pinched_nodes = topology.pinched_vertices;
   c.euler = topology.euler();
-  c.rim_loops = topology.boundary_loops;
+  c.rim_loops = detail::count_boundary_loops(scratch);
   for (const Edge& e : s.rim_edges) c.oblique_rim_edges += !edge_is_axis_parallel(mesh, e.first, e.second);
 }
 

@@ -234,10 +234,11 @@ void check_manifold_vertices(const TriangleSurface& surface, const std::vector<E
 void check_disk(const TriangleSurface& surface) {
   detail::TopologyScratch scratch;
   const detail::TriangleTopology topology = detail::triangle_topology(surface.triangles, scratch);
+  const int boundary_loops = detail::count_boundary_loops(scratch);
   if (topology.boundary_edges == 0)
     fail(surface, "closed surface (no boundary edges): an open surface with one boundary loop is required");
-  if (topology.boundary_loops != 1)
-    fail(surface, "not a topological disk: " + std::to_string(topology.boundary_loops) +
+  if (boundary_loops != 1)
+    fail(surface, "not a topological disk: " + std::to_string(boundary_loops) +
                       " boundary loops (the surface has holes); exactly 1 is required");
   if (topology.euler() != 1)
     fail(surface, "not a topological disk: Euler characteristic V - E + F = " + std::to_string(topology.vertices) +

@@ -14,6 +14,8 @@
 # of the parameterized stage tests (l_r = 1/32, perturbed) and the Gmsh reference mesher (a third-party
 # library that is not instrumented).
 set -euo pipefail
+: "${CMAKE_GENERATOR:=Ninja}"   # for new build trees only (CMake reads it when it creates one)
+export CMAKE_GENERATOR
 cd "$(dirname "$0")/.."
 quick=false
 if [ "${1:-}" = "--quick" ]; then quick=true; shift; fi

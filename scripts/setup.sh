@@ -5,6 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config
+  ninja-build                         # the scripts' CMake generator: tests compile while the library links
   libeigen3-dev                       # the module's only library dependency (with OpenMP)
   libgtest-dev libbenchmark-dev       # tests and benchmarks
   libgmsh-dev gmsh                    # independent MSH reader in the tests, reference meshes

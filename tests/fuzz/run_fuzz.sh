@@ -13,6 +13,8 @@
 # tests/fuzz/corpus/ stay as they are); a crashing input is saved as <build-dir>/artifacts/<target>-*
 # and can be replayed with: <build-dir>/tests/fuzz/<target> <file>.
 set -euo pipefail
+: "${CMAKE_GENERATOR:=Ninja}"   # for new build trees only (CMake reads it when it creates one)
+export CMAKE_GENERATOR
 cd "$(dirname "$0")/../.."
 parallel=0
 if [ "${1:-}" = --parallel ]; then parallel=1; shift; fi

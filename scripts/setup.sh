@@ -14,7 +14,7 @@ packages=(
   python3-dolfinx python3-gmsh        # the user guide's dolfinx example, run by CTest (tests/dolfinx/)
   python3 python3-matplotlib python3-numpy   # plots in doc/
   clang libclang-rt-14-dev libomp-dev  # libFuzzer targets (tests/fuzz/): clang's sanitizers, libFuzzer, OpenMP
-  clang-format                        # .clang-format: checking the C++ style (clang-format --dry-run)
+  clang-format clang-tidy             # .clang-format and .clang-tidy: style and static checks in CI
 )
 
 missing=()

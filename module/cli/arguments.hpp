@@ -49,7 +49,7 @@ class ArgumentParser {
   explicit ArgumentParser(std::string context = "") : context_(std::move(context)) {}
 
   ArgumentParser& flag(std::vector<std::string> names, std::function<void()> handler) {
-    return declare(std::move(names), false, false, [handler](const std::string&) { handler(); });
+    return declare(std::move(names), false, false, [handler = std::move(handler)](const std::string&) { handler(); });
   }
 
   // --help and -h: the usage text on stdout, and exit status 0.

@@ -426,7 +426,7 @@ int run(const Options& options) {
   insertion.finer_retries = options.finer_retries;
   // Without a callback the stages build no progress lines at all.
   if (!options.quiet) insertion.progress = [&progress](const std::string& line) { progress.say(line); };
-  const meccano::InsertionResult result = meccano::insert_surfaces(std::move(mesh), surfaces, insertion);
+  const meccano::InsertionResult result = meccano::insert_surfaces(mesh, surfaces, insertion);
 
   // A tangled mesh is written only as the projection stage's inspection output.
   const auto check =

@@ -551,7 +551,7 @@ double finer_resolution(const MeccanoGrid& meccano, const Clearances& clearance,
 }
 
 // The insertion at l_r, and where it fails, again with the failing surfaces at a finer l_r.
-InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces,
+InsertionResult insert_surfaces(const TetMesh& mesh, std::span<const TriangleSurface> surfaces,
                                 const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();
   std::int64_t estimated_tets = mesh.num_tets();

@@ -696,7 +696,7 @@ std::string SurfaceApproximationCheck::describe() const {
 
 HealingStats approximate_surface(TetMesh& mesh, TetRegion& volumetric, const TriangleSurface& surface,
                                  const TriangleBVH& tree, int index, const SurfaceApproximationOptions& options,
-                                 std::vector<TetRegion*> other_regions) {
+                                 const std::vector<TetRegion*>& other_regions) {
   const FaceTag tag = interface_tag(index);
   const SideClassifier sides(surface, tree);
   std::vector<int> sides_to_try;

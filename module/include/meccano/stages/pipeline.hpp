@@ -110,7 +110,7 @@ struct InsertionResult {
   std::vector<std::string> finer_retries;  // why it was run again with finer l_r for some surfaces, in order
 };
 
-InsertionResult insert_surfaces(TetMesh mesh, std::span<const TriangleSurface> surfaces,
+InsertionResult insert_surfaces(const TetMesh& mesh, std::span<const TriangleSurface> surfaces,
                                 const InsertionOptions& options);
 
 // `domain`, the box sides, and `interface_NAME` for every surface's S_M (once built), oriented like the

@@ -92,7 +92,7 @@ struct HealingStats {
 // Builds and heals S_M of surface `index` and tags its faces interface_tag(index).
 HealingStats approximate_surface(TetMesh& mesh, TetRegion& volumetric, const TriangleSurface& surface,
                                  const TriangleBVH& tree, int index, const SurfaceApproximationOptions& options = {},
-                                 std::vector<TetRegion*> other_regions = {});
+                                 const std::vector<TetRegion*>& other_regions = {});
 
 // The faces of S_M (tag interface_tag(index)), each once, oriented like S: the normal (right-hand rule on
 // the vertex order) points to the side of S that S_M lies on when side = +1, and away from it when

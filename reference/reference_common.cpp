@@ -68,22 +68,19 @@ void parse_arguments(int argc, char** argv, const char* usage_text, CommonOption
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-void check_outputs_writable(const CommonOptions& options) {
+RunStart start_run(const CommonOptions& options) {
+  RunStart run{Clock::now(), Progress(options.quiet), {}};
   require_writable(options.output);
   if (options.report) require_writable(*options.report);
-}
-
-std::vector<TriangleSurface> read_valid_surfaces(const CommonOptions& options, const Progress& progress) {
-  std::vector<TriangleSurface> surfaces;
   for (const auto& [file, name] : options.surfaces) {
-    surfaces.push_back(read_surface(file));
-    surfaces.back().name = name;
-    progress.say("surface ", name, ": ", file, ", ", surfaces.back().triangles.size(), " triangles, ",
-                 surfaces.back().points.size(), " points");
+    run.surfaces.push_back(read_surface(file));
+    run.surfaces.back().name = name;
+    run.progress.say("surface ", name, ": ", file, ", ", run.surfaces.back().triangles.size(), " triangles, ",
+                     run.surfaces.back().points.size(), " points");
   }
-  validate_surfaces(surfaces, options.box);
-  progress.say("surfaces valid: open disks, inside the box, disjoint");
-  return surfaces;
+  validate_surfaces(run.surfaces, options.box);
+  run.progress.say("surfaces valid: open disks, inside the box, disjoint");
+  return run;
 }
 
 MeshSummary summarize_tets(std::size_t tet_count, std::size_t node_count,

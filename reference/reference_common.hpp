@@ -1,4 +1,4 @@
-// What the reference meshers of meshes/ (reference-gmsh, reference-tetgen) share: the command-line
+// What the reference meshers of reference/ (reference-gmsh, reference-tetgen) share: the command-line
 // options that mean the same in both, the surfaces read and validated exactly as meccano-immerse reads
 // them, progress lines, the per-tet quality summary and the JSON report. No mesher library is linked
 // here: libgmsh and libtet both define TetGen's symbols and must never meet in one executable.
@@ -7,8 +7,9 @@
 //           (repeatable; NAME defaults to the 1-based position), --size H, --output FILE.msh,
 //           --report FILE.json, --quiet (-q). A usage error throws UsageError, which the tools turn
 //           into exit status 2.
-// Surfaces  read_valid_surfaces: read_surface + validate_surfaces (open disks strictly inside the box,
-//           disjoint); InputError names the file, the element and the defect.
+// Start     start_run: the clock and progress of a run, the outputs required writable, and the surfaces
+//           read and validated (read_surface + validate_surfaces: open disks strictly inside the box,
+//           disjoint; InputError names the file, the element and the defect), all before meshing.
 // Quality   summarize_tets: meccano's per-tet mean ratio (equilateral) and dihedral angles with the rules
 //           of meccano::summarize_quality (an inverted tet counts as quality 0; angles of valid tets
 //           only), so that every tool is measured alike.
@@ -61,12 +62,16 @@ double seconds_since(Clock::time_point start);
 
 using tools::Progress;
 
-// Throws InputError naming the first of --output and --report that cannot be written (require_writable);
-// a tool calls it before meshing.
-void check_outputs_writable(const CommonOptions& options);
-
-// The surfaces of the options, named, in order, validated against the box.
-std::vector<TriangleSurface> read_valid_surfaces(const CommonOptions& options, const Progress& progress);
+// What every run does before it meshes: starts its clock and progress, throws InputError naming the first
+// of --output and --report that cannot be written (require_writable), and reads the surfaces of the
+// options, named, in order, validated against the box. Every input error is found before the mesher runs,
+// with meccano-immerse's messages.
+struct RunStart {
+  Clock::time_point start;
+  Progress progress;
+  std::vector<TriangleSurface> surfaces;
+};
+RunStart start_run(const CommonOptions& options);
 
 struct MeshSummary {
   std::size_t tets = 0;

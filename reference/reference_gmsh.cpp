@@ -305,13 +305,8 @@ double mean_edge_length(const meccano::TriangleSurface& surface) {
 
 int run(const Options& options) {
   using meccano::reference::Clock;
-  const auto start = Clock::now();
   const meccano::reference::CommonOptions& common = options.common;
-  const meccano::reference::Progress progress(common.quiet);
-  meccano::reference::check_outputs_writable(common);
-  // Every surface is read and validated before Gmsh starts: the same inputs as meccano-immerse, with
-  // the same messages.
-  const std::vector<meccano::TriangleSurface> surfaces = meccano::reference::read_valid_surfaces(common, progress);
+  const auto [start, progress, surfaces] = meccano::reference::start_run(common);
   const char* size_option = options.size_field ? "--size-near-surface" : "--size";
   const double size_at_surfaces = options.size_field ? options.size_field->near_surface : *common.size;
   for (const auto& surface : surfaces)

@@ -318,13 +318,9 @@ void write_msh41(const ReferenceMesh& mesh, const std::vector<meccano::TriangleS
 
 int run(const Options& options) {
   using meccano::reference::Clock;
-  const auto start = Clock::now();
   const meccano::reference::CommonOptions& common = options.common;
-  const meccano::reference::Progress progress(common.quiet);
-  meccano::reference::check_outputs_writable(common);
-  // Every surface is read and validated before TetGen starts: the same inputs as meccano-immerse, with
-  // the same messages, and no TetGen failure for what meccano-immerse would reject.
-  const std::vector<meccano::TriangleSurface> surfaces = meccano::reference::read_valid_surfaces(common, progress);
+  // No TetGen failure for what meccano-immerse would reject: start_run validates the surfaces first.
+  const auto [start, progress, surfaces] = meccano::reference::start_run(common);
 
   tetgenio in;
   fill_plc(common.box, surfaces, in);

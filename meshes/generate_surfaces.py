@@ -225,6 +225,33 @@ def vertical():
     return points, grid_triangles(points, columns, rows)
 
 
+def thin_tail():
+    """A fault 60 km along a strike that turns from 80 to 95 degrees off the x axis, dipping 75 degrees,
+    whose lower edge rises from 8 km below its top trace to 1.5 km over 3 km, 40 km along, then to 1.2 km
+    at its east end: a tail 17 km long and narrower than V_M's cubes at E/30, as the east end of the
+    Western Santa Cruz Island fault is; 1 km jittered cells along strike, 12 rows down dip (cells of
+    the tail about 120 m deep)."""
+    columns, rows, cell = 60, 12, 1000.0
+    length = columns * cell
+    heading0, heading1 = math.radians(80), math.radians(95)
+    origin = (176000.0, 3772000.0, -60.0)
+
+    def depth(s):
+        if s <= 40000.0:
+            return 8000.0
+        if s <= 43000.0:
+            return 8000.0 - 6500.0 * (s - 40000.0) / 3000.0
+        return 1500.0 - 300.0 * (s - 43000.0) / (length - 43000.0)
+
+    points = []
+    for u, v in jittered_grid(columns, rows, seed=6, fixed_columns=(40, 43)):
+        s = u * cell
+        heading = heading0 + (heading1 - heading0) * s / length
+        points.append(add(origin, arc_trace(s, length, heading0, heading1),
+                          scaled(down_dip(heading, math.radians(75)), v * depth(s) / rows / math.sin(math.radians(75)))))
+    return points, grid_triangles(points, columns, rows)
+
+
 def newest_vertex_bisection(points, triangles, too_large):
     """Refines a conforming triangulation by newest-vertex bisection until no triangle is too_large(its
     three points). Each triangle (a, b, c) is cut at the midpoint m of its refinement edge a-b into
@@ -314,7 +341,7 @@ def multiscale():
 
 
 HARD_SURFACES = {"creased": creased, "multiscale": multiscale, "thin_long": thin_long, "low_dip": low_dip,
-                 "vertical": vertical}
+                 "vertical": vertical, "thin_tail": thin_tail}
 
 
 def main():

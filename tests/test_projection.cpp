@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <utility>
 #include <vector>
@@ -104,6 +105,45 @@ TEST(Projection, HausdorffDistanceShrinksAsTheResolutionHalves) {
     const double rate = std::log2(distances[i - 1] / distances[i]);
     EXPECT_GT(rate, 1.0) << "level " << i << ": " << distances[i - 1] << " -> " << distances[i];
   }
+}
+
+// The rim gap against a brute-force directed Hausdorff distance: S's rim a wavy loop, S_M's a square
+// loop that covers the loop's left part only, both densely sampled, so the early exit is exercised.
+TEST(Projection, RimGapIsTheFarthestRimVertexOfSFromTheRimOfSM) {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> surface_rim, approximation_rim;
+  for (int k = 0; k < 200; ++k) {
+    const double angle = 2 * std::numbers::pi * k / 200;
+    surface_rim.push_back(static_cast<int>(points.size()));
+    points.emplace_back(std::cos(angle), std::sin(angle), 0.05 * std::sin(7 * angle));
+  }
+  const std::array<Eigen::Vector3d, 4> square = {Eigen::Vector3d(-1.1, -1.1, 0), Eigen::Vector3d(0.3, -1.1, 0),
+                                                 Eigen::Vector3d(0.3, 1.1, 0), Eigen::Vector3d(-1.1, 1.1, 0)};
+  for (int side = 0; side < 4; ++side)
+    for (int k = 0; k < 50; ++k) {
+      approximation_rim.push_back(static_cast<int>(points.size()));
+      points.push_back(square[side] + (square[(side + 1) % 4] - square[side]) * k / 50.0);
+    }
+  double farthest = 0.0;
+  int vertex = -1;
+  for (int v : surface_rim) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < approximation_rim.size(); ++k)
+      for (int sample = 0; sample <= 100; ++sample) {
+        const Eigen::Vector3d& a = points[approximation_rim[k]];
+        const Eigen::Vector3d& b = points[approximation_rim[(k + 1) % approximation_rim.size()]];
+        nearest = std::min(nearest, (a + (b - a) * sample / 100.0 - points[v]).norm());
+      }
+    if (nearest > farthest) {
+      farthest = nearest;
+      vertex = v;
+    }
+  }
+  const RimGap gap = rim_gap(points, surface_rim, points, approximation_rim);
+  EXPECT_EQ(gap.vertex, vertex);
+  EXPECT_NEAR(gap.distance, farthest, 1e-3);  // the samples are 1e-3 apart along the square's sides
+  EXPECT_NEAR(gap.distance, 0.7, 0.01);       // (1, 0, 0) lies 0.7 beyond the side x = 0.3
+  EXPECT_EQ(rim_gap(points, surface_rim, points, surface_rim).distance, 0.0);
 }
 
 // A roof folded by 2 atan(0.3) = 33 degrees along x = 0.5. Followed (surface/creases.hpp), the fold is a path of

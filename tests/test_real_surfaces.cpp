@@ -10,6 +10,7 @@
 // held below the value measured on each case when this test was written, rounded up by a few degrees,
 // so that a change that brings back the chords across creases fails.
 
+#include <meccano/error.hpp>
 #include <meccano/inspect/mesh_file_measure.hpp>
 #include <meccano/io/mesh_writers.hpp>
 #include <meccano/io/surface_readers.hpp>
@@ -104,6 +105,35 @@ INSTANTIATE_TEST_SUITE_P(
         RealCase{"thin_long_E30", hard_surface("thin_long.obj"), false, 30, 3},
         RealCase{"vertical_E30", hard_surface("vertical.obj"), false, 30, 3}),
     [](const ::testing::TestParamInfo<RealCase>& test) { return test.param.name; });
+
+// A fault whose east end is a tail 1.2-1.5 km deep, narrower than V_M's cubes at E/30 (about 2 km), as
+// Western Santa Cruz Island's is: S_M cannot cover the tail, and projecting it would drag its rim nodes
+// some 16 km along S. The rim gap says so before smoothing, and the retry at a finer l_r covers it.
+TEST(ThinTail, AnUncoveredPartOfSFailsBeforeSmoothingAndIsRetriedFiner) {
+  TriangleSurface surface = read_surface(hard_surface("thin_tail.obj"));
+  surface.name = "tail";
+  const double extent = testing::largest_extent(surface);
+  const TetMesh mesh = make_cube_meccano(testing::box_around(surface), 0);
+  InsertionOptions options;
+  options.resolution = extent / 30;
+  options.finer_retries = 0;
+  try {
+    insert_surfaces(mesh, {&surface, 1}, options);
+    ADD_FAILURE() << "the tail was inserted at E/30 without a retry: the test lost its point";
+  } catch (const MeshingError& failure) {
+    const std::string message = failure.what();
+    EXPECT_NE(message.find("S_M leaves part of S uncovered"), std::string::npos) << message;
+    EXPECT_EQ(message.find("sweeps"), std::string::npos) << "smoothing ran first: " << message;
+  }
+
+  options.finer_retries = InsertionOptions{}.finer_retries;
+  const InsertionResult result = insert_surfaces(mesh, {&surface, 1}, options);
+  ASSERT_EQ(result.finer_retries.size(), 1U);
+  EXPECT_NE(result.finer_retries[0].find("uncovered"), std::string::npos) << result.finer_retries[0];
+  EXPECT_TRUE(verify_mesh(result.mesh).ok());
+  EXPECT_LE(result.surfaces[0].projection.stats.rim_gap, max_rim_gap_in_resolutions * result.surfaces[0].resolution);
+  EXPECT_LT(result.surfaces[0].resolution, options.resolution);
+}
 
 }  // namespace
 }  // namespace meccano

@@ -50,6 +50,7 @@ void write_surface(JsonWriter& json, const SurfaceInsertion& inserted, Stage las
     json.key("projection").begin_object();
     json.key("nodes").value(p.nodes).key("rim_nodes").value(p.rim_nodes);
     json.key("largest_move").value(p.largest_move).key("largest_distance_after").value(p.largest_distance_after);
+    json.key("rim_gap").value(p.rim_gap);
     json.key("inverted_tets").value(p.inverted_tets);
     json.key("creases").begin_object();
     json.key("lines").value(p.creases.lines).key("crossings").value(p.creases.crossings);

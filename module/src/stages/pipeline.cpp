@@ -82,7 +82,8 @@ void report_projection(const InsertionOptions& options, const SurfaceInsertion& 
   const auto& p = inserted.projection.stats;
   report(options, "projection ", inserted.name, ": ", p.nodes, " nodes (", p.rim_nodes, " on the rim, ",
          p.creases.nodes, " on ", p.creases.lines, " creases) moved by up to ", p.largest_move, ", now within ",
-         p.largest_distance_after, " of S; ", p.inverted_tets, " tets inverted (smoothing untangles them)");
+         p.largest_distance_after, " of S; S's rim within ", p.rim_gap / inserted.resolution, " l_r of S_M's; ",
+         p.inverted_tets, " tets inverted (smoothing untangles them)");
 }
 
 // The smoothing options, reporting each sweep when the caller follows the progress.
@@ -198,8 +199,12 @@ void project_onto_surfaces(InsertionResult& result, std::span<const TriangleSurf
   for (int s = 0; s < static_cast<int>(surfaces.size()); ++s) {
     SurfaceInsertion& inserted = result.surfaces[s];
     const auto start = std::chrono::steady_clock::now();
-    inserted.projection = project_onto_surface(result.mesh, inserted.volumetric, s, inserted.healing_stats.side,
-                                               surfaces[s], trees[s], options.projection);
+    ProjectionOptions projection = options.projection;
+    projection.max_rim_gap = std::min(projection.max_rim_gap, max_rim_gap_in_resolutions * inserted.resolution);
+    inserted.projection = for_surface(s, inserted.name, [&] {
+      return project_onto_surface(result.mesh, inserted.volumetric, s, inserted.healing_stats.side, surfaces[s],
+                                  trees[s], projection);
+    });
     inserted.projection_seconds = seconds_since(start);
     report_projection(options, inserted);
   }

@@ -1,12 +1,57 @@
 #include <meccano/stages/projection.hpp>
 
+#include <meccano/error.hpp>
 #include <meccano/mesh/quality.hpp>
 #include <meccano/stages/surface_approximation.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <sstream>
 
 namespace meccano {
+namespace {
+
+double squared_distance_to_segment(const Eigen::Vector3d& x, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double length_squared = ab.squaredNorm();
+  const double t = length_squared > 0.0 ? std::clamp((x - a).dot(ab) / length_squared, 0.0, 1.0) : 0.0;
+  return (a + t * ab - x).squaredNorm();
+}
+
+}  // namespace
+
+RimGap rim_gap(std::span<const Eigen::Vector3d> surface_points, std::span<const int> surface_rim,
+               std::span<const Eigen::Vector3d> approximation_points, std::span<const int> approximation_rim) {
+  // The directed Hausdorff distance with the usual early exit: a vertex closer to some segment than the
+  // largest distance so far cannot be the farthest. The scan starts at the segment nearest to the previous
+  // vertex, which is usually near this one too, so most vertices stop after a few segments.
+  RimGap gap;
+  const std::size_t segments = approximation_rim.size();
+  if (segments == 0 || surface_rim.empty()) return gap;
+  double largest = -1.0;  // squared
+  std::size_t start = 0;
+  for (int v : surface_rim) {
+    double nearest = std::numeric_limits<double>::infinity();
+    std::size_t nearest_segment = start;
+    for (std::size_t step = 0; step < segments && nearest > largest; ++step) {
+      const std::size_t k = (start + step) % segments;
+      const double distance = squared_distance_to_segment(surface_points[v], approximation_points[approximation_rim[k]],
+                                                          approximation_points[approximation_rim[(k + 1) % segments]]);
+      if (distance < nearest) {
+        nearest = distance;
+        nearest_segment = k;
+      }
+    }
+    start = nearest_segment;
+    if (nearest > largest) {
+      largest = nearest;
+      gap.vertex = v;
+    }
+  }
+  gap.distance = std::sqrt(largest);
+  return gap;
+}
 
 bool keeps_orientation(const SurfaceProjection& projection, const std::array<int, 3>& triangle, int moved,
                        const Eigen::Vector2d& uv) {
@@ -37,15 +82,27 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
   const DiskView approximation(pulled, triangles);
   const DiskView target(surface);
 
+  SurfaceProjection result;
+  ProjectionStats& stats = result.stats;
+  const std::vector<int> surface_rim = rim_loop(target);
+  const RimGap gap = rim_gap(surface.points, surface_rim, mesh.points, rim_loop(DiskView(mesh.points, triangles)));
+  stats.rim_gap = gap.distance;
+  if (gap.distance > options.max_rim_gap) {
+    const Eigen::Vector3d& x = surface.points[gap.vertex];
+    std::ostringstream message;
+    message << "S_M leaves part of S uncovered: rim vertex " << gap.vertex + 1 << " of S at (" << x.x() << ", " << x.y()
+            << ", " << x.z() << ") is " << gap.distance << " from S_M's rim (at most " << options.max_rim_gap
+            << " allowed); S is probably narrower there than V_M's cubes";
+    throw MeshingError(message.str());
+  }
+
   // Matching corners: S's by arc length, S_M's nearest to them around the same mean normal.
   const auto surface_corners = corners_by_arc_length(target);
-  const std::vector<int> surface_rim = rim_loop(target);
   const Eigen::Vector3d normal = vector_area(surface.points, surface_rim);
   std::array<Eigen::Vector3d, 4> targets;
   for (int k = 0; k < 4; ++k) targets[k] = surface.points[surface_corners[k]];
   const auto approximation_corners = matching_corners(approximation, targets, normal);
 
-  SurfaceProjection result;
   result.surface =
       std::make_unique<ParametricSurface>(target, parameterize_to_square(target, surface_corners, options.weights));
   const SquareParameterization own = parameterize_to_square(approximation, approximation_corners, options.weights);
@@ -56,7 +113,6 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
   std::vector<std::uint8_t> rim(mesh.points.size(), 0);
   for (int v : own.rim) rim[v] = 1;
 
-  ProjectionStats& stats = result.stats;
   const auto count = static_cast<std::int64_t>(result.nodes.size());
   result.uv.resize(result.nodes.size());
   result.on_rim.resize(result.nodes.size());

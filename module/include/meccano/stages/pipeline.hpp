@@ -4,7 +4,9 @@
 // Steps    1. volumetric approximation V_M of each surface (stages/volumetric_approximation.hpp);
 //          2. surface approximation S_M of each surface, healed (stages/surface_approximation.hpp); once all
 //             are built, any S_M that a later surface's refinement disturbed is healed again;
-//          3. projection of each S_M onto its surface (stages/projection.hpp);
+//          3. projection of each S_M onto its surface (stages/projection.hpp), unless S_M leaves part of S
+//             uncovered: a rim vertex of S more than max_rim_gap_in_resolutions l_r from S_M's rim fails
+//             the surface at once, before smoothing wastes its sweeps on tets no sweep can untangle;
 //          4. simultaneous untangling and smoothing of the whole mesh or of a band around the surfaces
 //             (stages/smoothing.hpp). If tets stay inverted, the insertion is run again with the S_M of the
 //             surfaces next to them on the other side of S (when the side rule allows it); a mesh that
@@ -12,12 +14,12 @@
 //          Then the worst tets are lifted (stages/improvement.hpp) unless options.improve is none; the quality
 //          after smoothing is that of the result, after the improvement.
 //          A surface whose insertion still fails (V_M cannot be grown within reach of S, S_M cannot be
-//          healed, or the tets next to its S_M stay tangled on both sides) is inserted again, from the
-//          input mesh, at a finer l_r, at most options.finer_retries times, together with the surfaces
-//          whose S_M could touch its own: half its l_r, or finer where the gap to those surfaces or to
-//          the box leaves no room for S_M at half (the gap decides the first finer l_r, instead of
-//          halving attempt after attempt). l_r is an upper bound on the edges near S, so a finer one
-//          still honours it. result.finer_retries says why.
+//          healed or does not cover S, or the tets next to its S_M stay tangled on both sides) is inserted
+//          again, from the input mesh, at a finer l_r, at most options.finer_retries times, together
+//          with the surfaces whose S_M could touch its own: half its l_r, or finer where the gap to those
+//          surfaces or to the box leaves no room for S_M at half (the gap decides the first finer l_r,
+//          instead of halving attempt after attempt). l_r is an upper bound on the edges near S, so a
+//          finer one still honours it. result.finer_retries says why.
 //          The surfaces are taken one after the other; a later surface's refinement keeps the earlier
 //          surfaces' regions in step (bisection does not change a region's point set).
 // Output   the refined mesh, each surface's V_M, per-stage statistics and timings; surface_interfaces()
@@ -55,6 +57,9 @@ enum class Improvement { none, smooth, topology };
 // arrays, about 200; the default limit keeps a run below 16 GiB.
 inline constexpr std::int64_t estimated_bytes_per_tet = 280;
 inline constexpr std::int64_t default_max_tets = (std::int64_t{16} << 30) / estimated_bytes_per_tet;
+
+// The largest rim gap (RimGap, stages/projection.hpp) projection accepts, in units of the surface's l_r.
+inline constexpr double max_rim_gap_in_resolutions = 3.0;
 
 // The tet count of an insertion, estimated before any refinement: the meccano's tets plus, per surface,
 // the cubes of V_M's level (level_for_resolution) that S crosses, from its area and normals, times the

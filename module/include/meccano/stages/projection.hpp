@@ -2,10 +2,14 @@
 //
 // Input    the mesh, the index and side of a healed S_M (stages/surface_approximation.hpp), and S.
 // Steps    1. S and S_M (its faces oriented like S) are parameterized onto P = [0,1]^2 with Floater's
-//             weights (stages/parameterization.hpp); S_M's weights are taken with its nodes pulled 80 % of the
-//             way onto S, so that the two parameterizations nearly agree (see stages/projection.cpp). S's corners are chosen along its rim by arc length (natural
-//             corners kept); S_M's are the rim nodes closest to them, in the same cyclic order around the
-//             same mean normal, so φ ∘ φ_M^{-1} does not twist.
+//             weights (stages/parameterization.hpp); S_M's weights are taken with its nodes pulled 80 % of
+//             the way onto S, so that the two parameterizations nearly agree (see stages/projection.cpp).
+//             S's corners are chosen along its rim by arc length (natural corners kept); S_M's are the rim
+//             nodes closest to them, in the same cyclic order around the same mean normal, so
+//             φ ∘ φ_M^{-1} does not twist.
+//             Before that, the rim gap (how far the farthest rim vertex of S lies from S_M's rim) is
+//             measured: where S_M leaves part of S uncovered, projection would drag rim nodes across the
+//             gap and tangle tets no smoothing can mend, so a gap above options.max_rim_gap is an error.
 //          2. S_M follows the creases of S sharper than options.crease_angle (surface/creases.hpp): nodes near a
 //             crease move, in P, onto it, forming paths of S_M edges along the crease lines.
 //          3. Each S_M node's parameters u (φ_M^{-1}(x_M), or its place on a crease) are located in S's
@@ -13,8 +17,9 @@
 //             corners on its corners, crease nodes on the crease edges of S.
 // Output   the moved mesh (tets may be tangled: step 4 untangles them), the parameterizations, and
 //          statistics: how far nodes moved, how far they are from S afterwards, inverted tets.
-// Errors   MeshingError from the parameterization (rim not one loop, corners impossible, map not
-//          one-to-one).
+// Errors   MeshingError if the rim gap exceeds options.max_rim_gap (the message names the rim vertex of
+//          S farthest from S_M), and from the parameterization (rim not one loop, corners impossible, map
+//          not one-to-one).
 #pragma once
 
 #include <meccano/geometry/geometry.hpp>
@@ -25,7 +30,9 @@
 #include <meccano/surface/triangle_surface.hpp>
 
 #include <array>
+#include <limits>
 #include <memory>
+#include <span>
 
 namespace meccano {
 
@@ -34,6 +41,7 @@ struct ProjectionStats {
   std::int64_t rim_nodes = 0;
   double largest_move = 0.0;            // physical distance, x_i - x_Mi
   double largest_distance_after = 0.0;  // of a moved node to S (round-off)
+  double rim_gap = 0.0;                 // RimGap::distance, before the move
   std::int64_t inverted_tets = 0;       // after the move, before smoothing
   CreaseStats creases;
 };
@@ -41,7 +49,19 @@ struct ProjectionStats {
 struct ProjectionOptions {
   FloaterWeights weights = FloaterWeights::mean_value;
   double crease_angle = default_crease_angle;  // degrees; creases of S sharper than this are followed (180: none)
+  double max_rim_gap =
+      std::numeric_limits<double>::infinity();  // physical distance; the pipeline sets a multiple of l_r
 };
+
+// How far S's rim strays from S_M's: the rim vertex of S farthest from the polyline of S_M's rim, and
+// that distance. A healthy S_M reaches beyond S's rim by up to about V_M's reach (a few l_r); it falls
+// short where S is narrower than V_M's cubes, whose S_M faces have every node on the rim or beyond it.
+struct RimGap {
+  double distance = 0.0;
+  int vertex = -1;  // of S
+};
+RimGap rim_gap(std::span<const Eigen::Vector3d> surface_points, std::span<const int> surface_rim,
+               std::span<const Eigen::Vector3d> approximation_points, std::span<const int> approximation_rim);
 
 // What step 4 needs to move S_M nodes within S: φ, and each S_M node's parameters.
 struct SurfaceProjection {

@@ -135,5 +135,29 @@ TEST(ThinTail, AnUncoveredPartOfSFailsBeforeSmoothingAndIsRetriedFiner) {
   EXPECT_LT(result.surfaces[0].resolution, options.resolution);
 }
 
+// Western Santa Cruz Island at E/50 and E/70: before S_M's triangles had a floor on their area in P,
+// two of its rim nodes slid onto one point during smoothing, the tets between them stayed flat on both
+// sides of S, and the retry at l_r / 2 made three times the tets. Now each is inserted as asked.
+TEST(WesternSantaCruzIsland, IsInsertedAtE50AndE70WithoutRetries) {
+  const std::string file = testing::shared_fault("WTRA-SFFS-SRSM-Western_Santa_Cruz_Island_fault_trim-CFM5_1000m.ts");
+  if (file.empty()) GTEST_SKIP() << "no shared fault data beside the checkout";
+  TriangleSurface surface = read_surface(file);
+  surface.name = "fault";
+  const double extent = testing::largest_extent(surface);
+  for (double divisor : {50.0, 70.0}) {
+    SCOPED_TRACE("E/" + std::to_string(static_cast<int>(divisor)));
+    InsertionOptions options;
+    options.resolution = extent / divisor;
+    const InsertionResult result =
+        insert_surfaces(make_cube_meccano(testing::box_around(surface), 0), {&surface, 1}, options);
+    EXPECT_TRUE(result.finer_retries.empty()) << result.finer_retries.front();
+    EXPECT_TRUE(result.side_retry.empty()) << result.side_retry;
+    EXPECT_TRUE(verify_mesh(result.mesh).ok());
+    const double tets = static_cast<double>(result.mesh.num_tets());
+    EXPECT_NEAR(static_cast<double>(result.estimated_tets) / tets, 1.0, 0.3)
+        << result.estimated_tets << " for " << tets;
+  }
+}
+
 }  // namespace
 }  // namespace meccano

@@ -54,10 +54,10 @@ RimGap rim_gap(std::span<const Eigen::Vector3d> surface_points, std::span<const 
 }
 
 bool keeps_orientation(const SurfaceProjection& projection, const std::array<int, 3>& triangle, int moved,
-                       const Eigen::Vector2d& uv) {
+                       const Eigen::Vector2d& uv, double least_area) {
   std::array<Eigen::Vector2d, 3> corner;
   for (int c = 0; c < 3; ++c) corner[c] = triangle[c] == moved ? uv : projection.uv[triangle[c]];
-  return cross2(corner[1] - corner[0], corner[2] - corner[0]) * projection.orientation > 0.0;
+  return cross2(corner[1] - corner[0], corner[2] - corner[0]) * projection.orientation > least_area;
 }
 
 SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,

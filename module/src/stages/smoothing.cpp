@@ -26,6 +26,12 @@ using Parameters = Vector3d;
 using Jacobian = Matrix3d;
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
+// No move may shrink an S_M triangle in P below this fraction of its area when smoothing began. Without
+// it, two rim nodes of Western Santa Cruz Island at E/50 slid onto one point (a triangle of area 3e-14 in P)
+// and left the three tets between them flat for good; 1 %, 10 % and 30 % all untangle it and E/70 in
+// 25-40 sweeps, and 1 % constrains the smoothing least (doc/benchmarks.md, "Western Santa Cruz Island
+// without retries").
+constexpr double uv_collapse_floor = 0.01;
 
 // ---------------------------------------------------------------------------------------------------
 // The distortion of one tet as a function of one of its vertices.
@@ -305,6 +311,7 @@ class Smoother {
   std::vector<NodeFreedom> freedom_;
   std::vector<std::vector<int>> hints_;  // per surface and node: the triangle of φ^-1(S) last holding it
   std::vector<std::vector<int>> triangle_start_, node_triangles_;  // per surface: node -> S_M triangles (CSR)
+  std::vector<std::vector<double>> least_uv_area_;                 // per surface and S_M triangle
   std::vector<TetId> active_tets_;
   SmoothingStats stats_;
   bool tangled_ = true;  // did the last sweep end with inverted tets (or none ran yet)?
@@ -329,8 +336,12 @@ void Smoother::classify_nodes() {
   hints_.resize(surfaces_.size());
   triangle_start_.resize(surfaces_.size());
   node_triangles_.resize(surfaces_.size());
+  least_uv_area_.resize(surfaces_.size());
   for (int s = 0; s < static_cast<int>(surfaces_.size()); ++s) {
     const SurfaceProjection& projection = *surfaces_[s];
+    for (const auto& t : projection.triangles)
+      least_uv_area_[s].push_back(uv_collapse_floor * std::abs(cross2(projection.uv[t[1]] - projection.uv[t[0]],
+                                                                      projection.uv[t[2]] - projection.uv[t[0]])));
     hints_[s].assign(projection.nodes.size(), -1);
     std::vector<int>& start = triangle_start_[s];
     start.assign(projection.nodes.size() + 1, 0);
@@ -562,7 +573,8 @@ bool Smoother::keeps_surface_embedded(const NodeFreedom& node, const Vector2d& u
   const SurfaceProjection& projection = *surfaces_[node.surface];
   const auto& start = triangle_start_[node.surface];
   for (int k = start[node.index]; k < start[node.index + 1]; ++k)
-    if (!keeps_orientation(projection, projection.triangles[node_triangles_[node.surface][k]], node.index, uv))
+    if (!keeps_orientation(projection, projection.triangles[node_triangles_[node.surface][k]], node.index, uv,
+                           least_uv_area_[node.surface][node_triangles_[node.surface][k]]))
       return false;
   return true;
 }

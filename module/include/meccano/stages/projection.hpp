@@ -76,9 +76,10 @@ struct SurfaceProjection {
 };
 
 // Whether S_M's triangle (indices of `projection.nodes`) keeps S_M's orientation in P with its node `moved`
-// at `uv` (the others at their parameters): what steps 3-4 and the improvement keep for every triangle.
+// at `uv` (the others at their parameters), with an area in P above `least_area`: what steps 3-4 and the
+// improvement keep for every triangle.
 bool keeps_orientation(const SurfaceProjection& projection, const std::array<int, 3>& triangle, int moved,
-                       const Eigen::Vector2d& uv);
+                       const Eigen::Vector2d& uv, double least_area = 0.0);
 
 SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,
                                        const TriangleSurface& surface, const TriangleBVH& tree,

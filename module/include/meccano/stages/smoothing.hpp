@@ -21,7 +21,8 @@
 //          corners are fixed. S_M nodes move in P = [0,1]² and sit at φ(u): the gradient and Hessian reach
 //          u by the chain rule through dφ/du, and every trial point is located again in φ's parametric
 //          triangulation (a short walk from the last triangle); a step that would fold one of S_M's
-//          triangles in P is refused, so S_M stays embedded in S. Rim nodes of S move along their side of
+//          triangles in P, or shrink it below 1 % of its area in P when smoothing began, is refused, so
+//          S_M stays embedded in S and no two of its nodes slide onto one point. Rim nodes of S move along their side of
 //          P, that is along the rim of S, and the four corners of P stay fixed: a fixed rim would keep the
 //          chord-length spacing of the projection, which ignores the volume mesh behind it. Nodes on a
 //          crease of S (surface/creases.hpp) move along their crease line of P, strictly inside it: they stay on

@@ -19,6 +19,8 @@ multiscale.obj     a gently curved fault whose triangles run from a few metres t
 thin_long.obj      a 40 km x 4 km strip (aspect 10:1), curved along strike and twisted
 low_dip.obj        a thrust dipping 5-10 degrees, undulating, 20 km along strike
 vertical.obj       an exactly vertical fault (dip 90 degrees) striking 30 degrees off the x axis, curved
+thin_tail.obj      a steep fault 60 km long whose last 17 km are a tail 1.2-1.5 km deep (as Western Santa
+                   Cruz Island's east end), narrower than V_M's cubes at l_r = E/30
 
 Usage: generate_surfaces.py [--output-dir DIR] [N]   (default N = 48, DIR = the current folder)
        generate_surfaces.py --hard [--output-dir DIR]   (the committed ones: DIR = tests/data/hard_surfaces)

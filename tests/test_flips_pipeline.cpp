@@ -96,10 +96,10 @@ TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
 // its place in 3D), the interface stays on S and oriented, the worst tet is no worse than SUS left it, and
 // the interface's normals follow S's more closely than without the mends.
 TEST(Creases, MendedAfterSmoothingPutSurfaceNodesOnTheLines) {
-  const std::string file = testing::shared_fault("PNRA-CRSF-YUHA-Shell_Beds_fault-CFM5_1000m.ts");
-  if (file.empty()) GTEST_SKIP() << "no shared fault data beside the checkout";
-  TriangleSurface surface = read_surface(file);
-  surface.name = "fault";
+  const std::optional<TriangleSurface> fault =
+      testing::read_shared_fault("PNRA-CRSF-YUHA-Shell_Beds_fault-CFM5_1000m.ts");
+  if (!fault) GTEST_SKIP() << "no shared fault data beside the checkout";
+  const TriangleSurface& surface = *fault;
   const Box box = testing::box_around(surface);
   InsertionOptions options;
   options.resolution = testing::largest_extent(surface) / 50;

@@ -139,10 +139,10 @@ TEST(ThinTail, AnUncoveredPartOfSFailsBeforeSmoothingAndIsRetriedFiner) {
 // two of its rim nodes slid onto one point during smoothing, the tets between them stayed flat on both
 // sides of S, and the retry at l_r / 2 made three times the tets. Now each is inserted as asked.
 TEST(WesternSantaCruzIsland, IsInsertedAtE50AndE70WithoutRetries) {
-  const std::string file = testing::shared_fault("WTRA-SFFS-SRSM-Western_Santa_Cruz_Island_fault_trim-CFM5_1000m.ts");
-  if (file.empty()) GTEST_SKIP() << "no shared fault data beside the checkout";
-  TriangleSurface surface = read_surface(file);
-  surface.name = "fault";
+  const std::optional<TriangleSurface> fault =
+      testing::read_shared_fault("WTRA-SFFS-SRSM-Western_Santa_Cruz_Island_fault_trim-CFM5_1000m.ts");
+  if (!fault) GTEST_SKIP() << "no shared fault data beside the checkout";
+  const TriangleSurface& surface = *fault;
   const double extent = testing::largest_extent(surface);
   for (double divisor : {50.0, 70.0}) {
     SCOPED_TRACE("E/" + std::to_string(static_cast<int>(divisor)));

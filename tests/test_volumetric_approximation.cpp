@@ -299,9 +299,10 @@ TEST(VolumetricApproximation, GrowthAcrossTheOffsetAtTheReachEnds) {
 // l_r of S bisected down to l_r / 12 all around S: 81 000 tets and five times the smoothing, against
 // 49 000 at the finer E/45. V_M is now one level, its growth completes the level's cubes within the reach.
 TEST(VolumetricApproximation, RealFaultGetsOneLevelAndNoFinerTets) {
-  const std::string file = testing::shared_fault("CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts");
-  if (file.empty()) GTEST_SKIP() << "no shared fault data beside the checkout";
-  const TriangleSurface surface = read_surface(file);
+  const std::optional<TriangleSurface> fault =
+      testing::read_shared_fault("CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts");
+  if (!fault) GTEST_SKIP() << "no shared fault data beside the checkout";
+  const TriangleSurface& surface = *fault;
   TetMesh mesh = make_cube_meccano(testing::box_around(surface), 0);
   ASSERT_NE(mesh.meccano.cell_size.x(), mesh.meccano.cell_size.z());
   const double resolution = testing::largest_extent(surface) / 40;

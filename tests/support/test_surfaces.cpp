@@ -1,5 +1,7 @@
 #include "test_surfaces.hpp"
 
+#include <meccano/io/surface_readers.hpp>
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -228,6 +230,14 @@ Box box_around(const TriangleSurface& surface, double margin) {
 std::string shared_fault(const std::string& file) {
   const std::filesystem::path path = std::filesystem::path(MECCANO_FAULTS_DIR) / file;
   return std::filesystem::exists(path) ? path.string() : std::string();
+}
+
+std::optional<TriangleSurface> read_shared_fault(const std::string& file) {
+  const std::string path = shared_fault(file);
+  if (path.empty()) return std::nullopt;
+  TriangleSurface surface = read_surface(path);
+  surface.name = "fault";
+  return surface;
 }
 
 std::vector<SurfaceCase> surface_cases(int n, bool with_perturbed) {

@@ -12,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -78,5 +79,9 @@ std::string write_obj(const std::string& path, const TriangleSurface& surface);
 // The shared fault file of that name (../shared/data/faults beside the checkout, GOCAD TSurf, UTM
 // metres), or an empty string when the data is not there: tests that need it skip.
 std::string shared_fault(const std::string& file);
+
+// That shared fault read as meccano-immerse reads it and named "fault", or nothing when the data is not
+// there: `if (!surface) GTEST_SKIP() << ...;`.
+std::optional<TriangleSurface> read_shared_fault(const std::string& file);
 
 }  // namespace meccano::testing

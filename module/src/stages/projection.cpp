@@ -60,66 +60,54 @@ bool keeps_orientation(const SurfaceProjection& projection, const std::array<int
   return cross2(corner[1] - corner[0], corner[2] - corner[0]) * projection.orientation > least_area;
 }
 
-SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,
-                                       const TriangleSurface& surface, const TriangleBVH& tree,
-                                       const ProjectionOptions& options) {
-  // S_M as a disk over the mesh's numbering, oriented like S. Its Floater weights are computed with each
-  // node pulled most of the way to its closest point p on S, x' = p + 0.2 (x - p), not on the staircase:
-  // the two parameterizations then nearly agree, so φ ∘ φ_M^{-1} moves nodes onto S instead of also
-  // sliding them along it (the staircase has up to √3 times S's area, unevenly spread). Measured on
-  // the cube example: the largest move falls with l_r (0.095 to 0.016 from l_r = 1/8 to 1/64) instead
-  // of staying near 0.06, and half as many tets are inverted. The remaining 0.2 keeps apart nodes
-  // beyond the rim of S, which share their closest point. Any positive weights keep the map one-to-one.
+namespace {
+
+// S_M's nodes pulled most of the way to their closest points p on S, x' = p + 0.2 (x - p), for its
+// Floater weights: the two parameterizations then nearly agree, so φ ∘ φ_M^{-1} moves nodes onto S
+// instead of also sliding them along it (the staircase has up to √3 times S's area, unevenly spread).
+// Measured on the cube example: the largest move falls with l_r (0.095 to 0.016 from l_r = 1/8 to 1/64)
+// instead of staying near 0.06, and half as many tets are inverted. The remaining 0.2 keeps apart nodes
+// beyond the rim of S, which share their closest point. Any positive weights keep the map one-to-one.
+std::vector<Eigen::Vector3d> pulled_towards_surface(const TetMesh& mesh, std::span<const std::array<int, 3>> triangles,
+                                                    const TriangleBVH& tree) {
   constexpr double kept_offset = 0.2;
-  const ApproximationFaces faces = approximation_faces(mesh, volumetric, index, side);
-  std::vector<std::array<int, 3>> triangles(faces.triangles.begin(), faces.triangles.end());
   std::vector<Eigen::Vector3d> pulled = mesh.points;
   for (const auto& t : triangles)
     for (int v : t) {
       const Eigen::Vector3d p = tree.closest_point(mesh.points[v]).point;
       pulled[v] = p + kept_offset * (mesh.points[v] - p);
     }
-  const DiskView approximation(pulled, triangles);
-  const DiskView target(surface);
+  return pulled;
+}
 
-  SurfaceProjection result;
-  ProjectionStats& stats = result.stats;
-  const std::vector<int> surface_rim = rim_loop(target);
-  const RimGap gap = rim_gap(surface.points, surface_rim, mesh.points, rim_loop(DiskView(mesh.points, triangles)));
-  stats.rim_gap = gap.distance;
-  if (gap.distance > options.max_rim_gap) {
-    const Eigen::Vector3d& x = surface.points[gap.vertex];
-    std::ostringstream message;
-    message << "S_M leaves part of S uncovered: rim vertex " << gap.vertex + 1 << " of S at (" << x.x() << ", " << x.y()
-            << ", " << x.z() << ") is " << gap.distance << " from S_M's rim (at most " << options.max_rim_gap
-            << " allowed); S is probably narrower there than V_M's cubes";
-    throw MeshingError(message.str());
-  }
+// The rim gap of S_M (its triangles over the mesh's points); throws MeshingError above `max_gap`.
+RimGap require_rim_covered(const TriangleSurface& surface, std::span<const int> surface_rim,
+                           const std::vector<Eigen::Vector3d>& points, std::span<const std::array<int, 3>> triangles,
+                           double max_gap) {
+  const RimGap gap = rim_gap(surface.points, surface_rim, points, rim_loop(DiskView(points, triangles)));
+  if (gap.distance <= max_gap) return gap;
+  const Eigen::Vector3d& x = surface.points[gap.vertex];
+  std::ostringstream message;
+  message << "S_M leaves part of S uncovered: rim vertex " << gap.vertex + 1 << " of S at (" << x.x() << ", " << x.y()
+          << ", " << x.z() << ") is " << gap.distance << " from S_M's rim (at most " << max_gap
+          << " allowed); S is probably narrower there than V_M's cubes";
+  throw MeshingError(message.str());
+}
 
-  // Matching corners: S's by arc length, S_M's nearest to them around the same mean normal.
-  const auto surface_corners = corners_by_arc_length(target);
-  const Eigen::Vector3d normal = vector_area(surface.points, surface_rim);
-  std::array<Eigen::Vector3d, 4> targets;
-  for (int k = 0; k < 4; ++k) targets[k] = surface.points[surface_corners[k]];
-  const auto approximation_corners = matching_corners(approximation, targets, normal);
-
-  result.surface =
-      std::make_unique<ParametricSurface>(target, parameterize_to_square(target, surface_corners, options.weights));
-  const SquareParameterization own = parameterize_to_square(approximation, approximation_corners, options.weights);
-
+// The S_M nodes (sorted), their parameters and rim flags from S_M's own parameterization, and S_M's
+// triangles over them.
+void take_parameters(SurfaceProjection& result, std::span<const std::array<int, 3>> triangles,
+                     const SquareParameterization& own, std::size_t mesh_points) {
   for (const auto& t : triangles) result.nodes.insert(result.nodes.end(), t.begin(), t.end());
   std::sort(result.nodes.begin(), result.nodes.end());
   result.nodes.erase(std::unique(result.nodes.begin(), result.nodes.end()), result.nodes.end());
-  std::vector<std::uint8_t> rim(mesh.points.size(), 0);
+  std::vector<std::uint8_t> rim(mesh_points, 0);
   for (int v : own.rim) rim[v] = 1;
-
-  const auto count = static_cast<std::int64_t>(result.nodes.size());
   result.uv.resize(result.nodes.size());
   result.on_rim.resize(result.nodes.size());
-  for (std::int64_t i = 0; i < count; ++i) {
-    const VertexId v = result.nodes[i];
-    result.uv[i] = own.uv[v];
-    result.on_rim[i] = rim[v];
+  for (std::size_t i = 0; i < result.nodes.size(); ++i) {
+    result.uv[i] = own.uv[result.nodes[i]];
+    result.on_rim[i] = rim[result.nodes[i]];
   }
   result.orientation = own.orientation;
   for (const auto& t : triangles) {
@@ -128,9 +116,12 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
       local[k] =
           static_cast<int>(std::lower_bound(result.nodes.begin(), result.nodes.end(), t[k]) - result.nodes.begin());
   }
-  result.creases = follow_creases(crease_lines(surface, result.surface->parameterization().uv, options.crease_angle),
-                                  result.triangles, result.uv, result.on_rim, result.orientation);
-  stats.creases = result.creases.stats;
+}
+
+// Every S_M node moves to φ of its parameters.
+void move_nodes_onto_surface(TetMesh& mesh, SurfaceProjection& result, const TriangleBVH& tree) {
+  ProjectionStats& stats = result.stats;
+  const auto count = static_cast<std::int64_t>(result.nodes.size());
   std::vector<Eigen::Vector3d> moved(result.nodes.size());
 #pragma omp parallel for schedule(dynamic, 256)
   for (std::int64_t i = 0; i < count; ++i) moved[i] = result.surface->evaluate(result.surface->locate(result.uv[i]));
@@ -142,8 +133,41 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
         std::max(stats.largest_distance_after, std::sqrt(tree.closest_point(moved[i]).squared_distance));
   }
   stats.nodes = count;
-  stats.rim_nodes = static_cast<std::int64_t>(own.rim.size());
-  stats.inverted_tets = count_inverted(mesh);
+}
+
+}  // namespace
+
+SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,
+                                       const TriangleSurface& surface, const TriangleBVH& tree,
+                                       const ProjectionOptions& options) {
+  // S_M as a disk over the mesh's numbering, oriented like S.
+  const ApproximationFaces faces = approximation_faces(mesh, volumetric, index, side);
+  const std::vector<std::array<int, 3>> triangles(faces.triangles.begin(), faces.triangles.end());
+  const DiskView target(surface);
+  const std::vector<int> surface_rim = rim_loop(target);
+  SurfaceProjection result;
+  result.stats.rim_gap =
+      require_rim_covered(surface, surface_rim, mesh.points, triangles, options.max_rim_gap).distance;
+
+  // Matching corners: S's by arc length, S_M's nearest to them around the same mean normal.
+  const std::vector<Eigen::Vector3d> pulled = pulled_towards_surface(mesh, triangles, tree);
+  const DiskView approximation(pulled, triangles);
+  const auto surface_corners = corners_by_arc_length(target);
+  const Eigen::Vector3d normal = vector_area(surface.points, surface_rim);
+  std::array<Eigen::Vector3d, 4> targets;
+  for (int k = 0; k < 4; ++k) targets[k] = surface.points[surface_corners[k]];
+  const auto approximation_corners = matching_corners(approximation, targets, normal);
+
+  result.surface =
+      std::make_unique<ParametricSurface>(target, parameterize_to_square(target, surface_corners, options.weights));
+  const SquareParameterization own = parameterize_to_square(approximation, approximation_corners, options.weights);
+  take_parameters(result, triangles, own, mesh.points.size());
+  result.creases = follow_creases(crease_lines(surface, result.surface->parameterization().uv, options.crease_angle),
+                                  result.triangles, result.uv, result.on_rim, result.orientation);
+  result.stats.creases = result.creases.stats;
+  move_nodes_onto_surface(mesh, result, tree);
+  result.stats.rim_nodes = static_cast<std::int64_t>(own.rim.size());
+  result.stats.inverted_tets = count_inverted(mesh);
   return result;
 }
 

@@ -88,6 +88,7 @@ RimGap require_rim_covered(const TriangleSurface& surface, std::span<const int> 
   if (gap.distance <= max_gap) return gap;
   const Eigen::Vector3d& x = surface.points[gap.vertex];
   std::ostringstream message;
+  message.precision(10);  // UTM coordinates to the millimetre
   message << "S_M leaves part of S uncovered: rim vertex " << gap.vertex + 1 << " of S at (" << x.x() << ", " << x.y()
           << ", " << x.z() << ") is " << gap.distance << " from S_M's rim (at most " << max_gap
           << " allowed); S is probably narrower there than V_M's cubes";

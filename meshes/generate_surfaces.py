@@ -21,6 +21,7 @@ low_dip.obj        a thrust dipping 5-10 degrees, undulating, 20 km along strike
 vertical.obj       an exactly vertical fault (dip 90 degrees) striking 30 degrees off the x axis, curved
 thin_tail.obj      a steep fault 60 km long whose last 17 km are a tail 1.2-1.5 km deep (as Western Santa
                    Cruz Island's east end), narrower than V_M's cubes at l_r = E/30
+sharp_tip.obj      a fault 40 km long tapering to a 10 degree tip, narrower than V_M's cubes near it at any l_r
 
 Usage: generate_surfaces.py [--output-dir DIR] [N]   (default N = 48, DIR = the current folder)
        generate_surfaces.py --hard [--output-dir DIR]   (the committed ones: DIR = tests/data/hard_surfaces)
@@ -254,6 +255,37 @@ def thin_tail():
     return points, grid_triangles(points, columns, rows)
 
 
+def sharp_tip():
+    """A fault 40 km along strike (the x axis), dipping 60 degrees, bowed by 300 m, whose width down dip
+    shrinks linearly from 7 km to a 10 degree tip at its east end: near the tip it is narrower than
+    V_M's cubes at any l_r, so S_M stops short of it by a few l_r on one side of S; 1 km columns of 8
+    cells each, the last one a fan into the tip."""
+    columns, rows, length = 40, 8, 40000.0
+    half_angle = math.radians(5)
+    dip = math.radians(60)
+    origin = (500000.0, 3800000.0, -4000.0)
+
+    def point(s, t):
+        return add(origin, (s, t * math.cos(dip) + 300 * math.sin(math.pi * s / length), -t * math.sin(dip)))
+
+    points = []
+    for i in range(columns):
+        s = length * i / columns
+        width = 2 * (length - s) * math.tan(half_angle)
+        points += [point(s, (j / rows - 0.5) * width) for j in range(rows + 1)]
+    tip = len(points)
+    points.append(point(length, 0.0))
+    triangles = []
+    for i in range(columns - 1):
+        for j in range(rows):
+            a, d = i * (rows + 1) + j, i * (rows + 1) + j + 1
+            b, c = a + rows + 1, d + rows + 1
+            triangles += [(a, b, c), (a, c, d)]
+    last = (columns - 1) * (rows + 1)
+    triangles += [(last + j, tip, last + j + 1) for j in range(rows)]
+    return points, triangles
+
+
 def newest_vertex_bisection(points, triangles, too_large):
     """Refines a conforming triangulation by newest-vertex bisection until no triangle is too_large(its
     three points). Each triangle (a, b, c) is cut at the midpoint m of its refinement edge a-b into
@@ -343,7 +375,7 @@ def multiscale():
 
 
 HARD_SURFACES = {"creased": creased, "multiscale": multiscale, "thin_long": thin_long, "low_dip": low_dip,
-                 "vertical": vertical, "thin_tail": thin_tail}
+                 "vertical": vertical, "thin_tail": thin_tail, "sharp_tip": sharp_tip}
 
 
 def main():

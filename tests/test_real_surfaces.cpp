@@ -107,8 +107,9 @@ INSTANTIATE_TEST_SUITE_P(
     [](const ::testing::TestParamInfo<RealCase>& test) { return test.param.name; });
 
 // A fault whose east end is a tail 1.2-1.5 km deep, narrower than V_M's cubes at E/30 (about 2 km), as
-// Western Santa Cruz Island's is: S_M cannot cover the tail, and projecting it would drag its rim nodes
-// some 16 km along S. The rim gap says so before smoothing, and the retry at a finer l_r covers it.
+// Western Santa Cruz Island's is: S_M cannot cover the tail on either side of S, and projecting it would
+// drag its rim nodes some 16 km along S. The rim gap says so before smoothing, on both sides, and the
+// retry at a finer l_r covers it. Where no finer retry is left the check is off, and smoothing fails.
 TEST(ThinTail, AnUncoveredPartOfSFailsBeforeSmoothingAndIsRetriedFiner) {
   TriangleSurface surface = read_surface(hard_surface("thin_tail.obj"));
   surface.name = "tail";
@@ -116,23 +117,42 @@ TEST(ThinTail, AnUncoveredPartOfSFailsBeforeSmoothingAndIsRetriedFiner) {
   const TetMesh mesh = make_cube_meccano(testing::box_around(surface), 0);
   InsertionOptions options;
   options.resolution = extent / 30;
-  options.finer_retries = 0;
-  try {
-    insert_surfaces(mesh, {&surface, 1}, options);
-    ADD_FAILURE() << "the tail was inserted at E/30 without a retry: the test lost its point";
-  } catch (const MeshingError& failure) {
-    const std::string message = failure.what();
-    EXPECT_NE(message.find("S_M leaves part of S uncovered"), std::string::npos) << message;
-    EXPECT_EQ(message.find("sweeps"), std::string::npos) << "smoothing ran first: " << message;
-  }
-
-  options.finer_retries = InsertionOptions{}.finer_retries;
   const InsertionResult result = insert_surfaces(mesh, {&surface, 1}, options);
   ASSERT_EQ(result.finer_retries.size(), 1U);
-  EXPECT_NE(result.finer_retries[0].find("uncovered"), std::string::npos) << result.finer_retries[0];
+  const std::string& reason = result.finer_retries[0];
+  EXPECT_NE(reason.find("S_M leaves part of S uncovered"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("on the other side: tail: S_M leaves part of S uncovered"), std::string::npos) << reason;
+  EXPECT_EQ(reason.find("sweeps"), std::string::npos) << "smoothing ran first: " << reason;
   EXPECT_TRUE(verify_mesh(result.mesh).ok());
   EXPECT_LE(result.surfaces[0].projection.stats.rim_gap, max_rim_gap_in_resolutions * result.surfaces[0].resolution);
   EXPECT_LT(result.surfaces[0].resolution, options.resolution);
+
+  options.finer_retries = 0;
+  try {
+    insert_surfaces(mesh, {&surface, 1}, options);
+    ADD_FAILURE() << "the tail was inserted at E/30 without a finer l_r: the test lost its point";
+  } catch (const MeshingError& failure) {
+    EXPECT_NE(std::string(failure.what()).find("tets are still inverted"), std::string::npos) << failure.what();
+  }
+}
+
+// A fault tapering to a 10 degree tip: near the tip it is narrower than V_M's cubes at every l_r, so a
+// finer l_r cannot close the rim gap (4-5 l_r on the positive side at E/30, E/50 and E/100). The other
+// side's S_M reaches about 2 l_r from the tip, which smoothing untangles: the side retry, decided before
+// any smoothing, inserts it at the l_r asked.
+TEST(SharpTip, AnUncoveredTipIsInsertedFromTheOtherSideAtTheResolutionAsked) {
+  TriangleSurface surface = read_surface(hard_surface("sharp_tip.obj"));
+  surface.name = "tip";
+  const double extent = testing::largest_extent(surface);
+  InsertionOptions options;
+  options.resolution = extent / 30;
+  const InsertionResult result =
+      insert_surfaces(make_cube_meccano(testing::box_around(surface), 0), {&surface, 1}, options);
+  EXPECT_TRUE(result.finer_retries.empty()) << result.finer_retries.front();
+  EXPECT_NE(result.side_retry.find("S_M leaves part of S uncovered"), std::string::npos) << result.side_retry;
+  EXPECT_EQ(result.surfaces[0].healing_stats.side, -1);
+  EXPECT_TRUE(verify_mesh(result.mesh).ok());
+  EXPECT_LE(result.surfaces[0].projection.stats.rim_gap, max_rim_gap_in_resolutions * options.resolution);
 }
 
 // Western Santa Cruz Island at E/50 and E/70: before S_M's triangles had a floor on their area in P,

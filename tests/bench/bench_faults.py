@@ -519,7 +519,7 @@ SCEC CFM faults of `shared/data/faults` (GOCAD TSurf, UTM metres, read as .ts; a
 some of a few metres) and the synthetic hard surfaces of `tests/data/hard_surfaces`
 (`meshes/generate_surfaces.py --hard`: creases of 10°, 25° and 40°, triangles from metres to
 kilometres, a 10:1 strip, a 5–10° thrust, an exactly vertical fault, a fault ending in a tail narrower
-than l_r at E/30). Each case's box is the surface's
+than l_r at E/30, a 10° tip). Each case's box is the surface's
 bounding box enlarged by {100 * BOX_MARGIN:.0f} % of E on every side, E the largest extent of that bounding box;
 l_r = E/30, E/50, E/70, E/100.
 

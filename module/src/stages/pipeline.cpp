@@ -42,6 +42,22 @@ class SurfaceFailure : public MeshingError {
   std::vector<int> surfaces;  // sorted, each once
 };
 
+// A surface whose S_M leaves part of S uncovered (UncoveredSurfaceError), with the side every surface's
+// S_M was built on: its S_M may cover S on the other side.
+class UncoveredFailure : public SurfaceFailure {
+ public:
+  UncoveredFailure(int failing, const std::string& message, std::vector<int> built_sides)
+      : SurfaceFailure({failing}, message), sides(std::move(built_sides)) {}
+  std::vector<int> sides;  // per surface, HealingStats::side
+};
+
+// The side each surface's S_M was built on.
+std::vector<int> sides_of(const InsertionResult& result) {
+  std::vector<int> sides;
+  for (const SurfaceInsertion& inserted : result.surfaces) sides.push_back(inserted.healing_stats.side);
+  return sides;
+}
+
 // Runs one surface's stage; its MeshingError becomes a SurfaceFailure naming the surface.
 template <class Run>
 auto for_surface(int s, const std::string& name, Run&& run) {
@@ -193,17 +209,23 @@ void approximate_surfaces(InsertionResult& result, std::span<const TriangleSurfa
   }
 }
 
-// Step 3: every S_M node moves onto its surface. Tets may be tangled until step 4.
+// Step 3: every S_M node moves onto its surface. Tets may be tangled until step 4. With
+// `require_coverage`, an S_M that leaves part of S uncovered throws UncoveredFailure first.
 void project_onto_surfaces(InsertionResult& result, std::span<const TriangleSurface> surfaces,
-                           std::span<const TriangleBVH> trees, const InsertionOptions& options) {
+                           std::span<const TriangleBVH> trees, const InsertionOptions& options, bool require_coverage) {
   for (int s = 0; s < static_cast<int>(surfaces.size()); ++s) {
     SurfaceInsertion& inserted = result.surfaces[s];
     const auto start = std::chrono::steady_clock::now();
     ProjectionOptions projection = options.projection;
-    projection.max_rim_gap = std::min(projection.max_rim_gap, max_rim_gap_in_resolutions * inserted.resolution);
+    if (require_coverage)
+      projection.max_rim_gap = std::min(projection.max_rim_gap, max_rim_gap_in_resolutions * inserted.resolution);
     inserted.projection = for_surface(s, inserted.name, [&] {
-      return project_onto_surface(result.mesh, inserted.volumetric, s, inserted.healing_stats.side, surfaces[s],
-                                  trees[s], projection);
+      try {
+        return project_onto_surface(result.mesh, inserted.volumetric, s, inserted.healing_stats.side, surfaces[s],
+                                    trees[s], projection);
+      } catch (const UncoveredSurfaceError& uncovered) {  // for_surface passes a SurfaceFailure on as it is
+        throw UncoveredFailure(s, inserted.name + ": " + uncovered.what(), sides_of(result));
+      }
     });
     inserted.projection_seconds = seconds_since(start);
     report_projection(options, inserted);
@@ -234,7 +256,8 @@ void lift_worst_tets(InsertionResult& result, std::span<SurfaceProjection* const
 }
 
 InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options,
-                           std::span<const SideRule> side_rules, std::span<const double> resolutions) {
+                           std::span<const SideRule> side_rules, std::span<const double> resolutions,
+                           bool require_coverage) {
   InsertionResult result;
   result.mesh = std::move(mesh);
   if (static_cast<int>(surfaces.size()) > max_interfaces)
@@ -250,7 +273,7 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
   check_stage(result.mesh, "approximation");
   if (options.last_stage == Stage::approximation) return result;
 
-  project_onto_surfaces(result, surfaces, trees, options);
+  project_onto_surfaces(result, surfaces, trees, options, require_coverage);
   const auto check = verify_mesh(result.mesh, {.physical = false});
   if (!check.ok()) throw MeshingError("mesh invalid after the projection stage: " + check.summary());
   result.quality_before_smoothing = summarize_quality(result.mesh);
@@ -378,15 +401,16 @@ std::vector<int> surfaces_next_to_inverted_tets(const InsertionResult& result) {
   return surfaces;
 }
 
-// The side rules of a second attempt: each surface next to an inverted tet (`next`), if its rule lets
-// it change sides, builds S_M on the other side only. Empty if no surface may change.
-std::vector<SideRule> other_side_rules(const InsertionResult& result, std::span<const int> next,
+// The side rules of a second attempt: each failing surface (`next`), if its rule lets it change sides,
+// builds S_M on the other side than `sides` (the side each S_M was built on) only. Empty if no surface
+// may change.
+std::vector<SideRule> other_side_rules(std::span<const int> sides, std::span<const int> next,
                                        std::span<const SideRule> rules) {
   std::vector<SideRule> retry(rules.begin(), rules.end());
   bool changed = false;
   for (int s : next) {
     if (rules[s] != SideRule::positive_first && rules[s] != SideRule::negative_first) continue;
-    retry[s] = result.surfaces[s].healing_stats.side > 0 ? SideRule::negative_only : SideRule::positive_only;
+    retry[s] = sides[s] > 0 ? SideRule::negative_only : SideRule::positive_only;
     changed = true;
   }
   return changed ? retry : std::vector<SideRule>{};
@@ -399,17 +423,18 @@ SurfaceFailure untangling_surface_failure(std::vector<int> next, int count, cons
   return SurfaceFailure(std::move(next), message);
 }
 
-// The stages at the given resolutions. A surface whose S_M cannot be untangled on one side of S may be
-// on the other: the stages run again from the input mesh with those surfaces' S_M on their other side,
-// as healing itself does. Throws SurfaceFailure when that fails too. Each failed run is added to `failed`.
+// The stages at the given resolutions. A surface whose S_M cannot be untangled on one side of S, or
+// leaves part of S uncovered there (checked when `require_coverage`), may do better on the other: the
+// stages run again from the input mesh with those surfaces' S_M on their other side, as healing itself
+// does. Throws SurfaceFailure when that fails too. Each failed run is added to `failed`.
 InsertionResult insert_on_either_side(const TetMesh& mesh, std::span<const TriangleSurface> surfaces,
                                       const InsertionOptions& options, std::span<const double> resolutions,
-                                      std::vector<FailedAttempt>& failed) {
+                                      bool require_coverage, std::vector<FailedAttempt>& failed) {
   const int count = static_cast<int>(surfaces.size());
   const std::vector<SideRule> rules(surfaces.size(), options.approximation.side_rule);
   auto run = [&](std::span<const SideRule> sides) {
     try {
-      return run_stages(mesh, surfaces, options, sides, resolutions);
+      return run_stages(mesh, surfaces, options, sides, resolutions, require_coverage);
     } catch (const SurfaceFailure& failure) {
       failed.push_back({attempt_settings(surfaces, resolutions, sides), failure.what(), ""});
       throw;
@@ -420,13 +445,26 @@ InsertionResult insert_on_either_side(const TetMesh& mesh, std::span<const Trian
                       untangling_explanation(options)});
     return untangling_failure(tangled);
   };
-  InsertionResult result = run(rules);
-  if (options.last_stage != Stage::smoothing || surfaces.empty() || result.smoothing.untangled()) return result;
-  const std::string failure = untangling_failed(result, rules);
-  std::vector<int> next = surfaces_next_to_inverted_tets(result);
-  const std::vector<SideRule> retry = other_side_rules(result, next, rules);
-  if (retry.empty()) throw untangling_surface_failure(std::move(next), count, failure);
-  report(options, "retrying with S_M on the other side of the surfaces next to inverted tets (", failure, ")");
+  std::string failure;
+  std::vector<int> next;
+  std::vector<SideRule> retry;
+  const char* which = "next to inverted tets";
+  try {
+    InsertionResult result = run(rules);
+    if (options.last_stage != Stage::smoothing || surfaces.empty() || result.smoothing.untangled()) return result;
+    failure = untangling_failed(result, rules);
+    next = surfaces_next_to_inverted_tets(result);
+    retry = other_side_rules(sides_of(result), next, rules);
+    if (retry.empty()) throw untangling_surface_failure(std::move(next), count, failure);
+  } catch (const UncoveredFailure& uncovered) {
+    failure = uncovered.what();
+    next = uncovered.surfaces;
+    retry = other_side_rules(uncovered.sides, next, rules);
+    if (retry.empty()) throw;
+    which = "whose S_M leaves part of S uncovered";
+  }
+  report(options, "retrying with S_M on the other side of the surfaces ", which, " (", failure, ")");
+  InsertionResult result;
   try {
     result = run(retry);
   } catch (const SurfaceFailure& other_side) {
@@ -576,7 +614,9 @@ InsertionResult insert_surfaces(const TetMesh& mesh, std::span<const TriangleSur
   for (int retry = 0;; ++retry) {
     std::vector<int> failing;
     try {
-      InsertionResult result = insert_on_either_side(mesh, surfaces, options, resolutions, failed);
+      // The last attempt skips the coverage check: smoothing then gets its chance, as no finer l_r will.
+      InsertionResult result =
+          insert_on_either_side(mesh, surfaces, options, resolutions, retry < options.finer_retries, failed);
       result.finer_retries = std::move(failures);
       result.estimated_tets = estimated_tets;
       result.seconds = seconds_since(pipeline_start);

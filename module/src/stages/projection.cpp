@@ -80,7 +80,7 @@ std::vector<Eigen::Vector3d> pulled_towards_surface(const TetMesh& mesh, std::sp
   return pulled;
 }
 
-// The rim gap of S_M (its triangles over the mesh's points); throws MeshingError above `max_gap`.
+// The rim gap of S_M (its triangles over the mesh's points); throws UncoveredSurfaceError above `max_gap`.
 RimGap require_rim_covered(const TriangleSurface& surface, std::span<const int> surface_rim,
                            const std::vector<Eigen::Vector3d>& points, std::span<const std::array<int, 3>> triangles,
                            double max_gap) {
@@ -92,7 +92,7 @@ RimGap require_rim_covered(const TriangleSurface& surface, std::span<const int> 
   message << "S_M leaves part of S uncovered: rim vertex " << gap.vertex + 1 << " of S at (" << x.x() << ", " << x.y()
           << ", " << x.z() << ") is " << gap.distance << " from S_M's rim (at most " << max_gap
           << " allowed); S is probably narrower there than V_M's cubes";
-  throw MeshingError(message.str());
+  throw UncoveredSurfaceError(message.str());
 }
 
 // The S_M nodes (sorted), their parameters and rim flags from S_M's own parameterization, and S_M's

@@ -6,7 +6,10 @@
 //             are built, any S_M that a later surface's refinement disturbed is healed again;
 //          3. projection of each S_M onto its surface (stages/projection.hpp), unless S_M leaves part of S
 //             uncovered: a rim vertex of S more than max_rim_gap_in_resolutions l_r from S_M's rim fails
-//             the surface at once, before smoothing wastes its sweeps on tets no sweep can untangle;
+//             the surface at once, before smoothing wastes its sweeps on tets no sweep can untangle, and
+//             the insertion runs again with that S_M on the other side (a 10 degree tip is narrower than
+//             the cubes at every l_r, and the other side may reach it), then at a finer l_r. The last
+//             attempt allowed skips this check: smoothing then gets its chance, as before the check;
 //          4. simultaneous untangling and smoothing of the whole mesh or of a band around the surfaces
 //             (stages/smoothing.hpp). If tets stay inverted, the insertion is run again with the S_M of the
 //             surfaces next to them on the other side of S (when the side rule allows it); a mesh that

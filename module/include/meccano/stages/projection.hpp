@@ -17,11 +17,12 @@
 //             corners on its corners, crease nodes on the crease edges of S.
 // Output   the moved mesh (tets may be tangled: step 4 untangles them), the parameterizations, and
 //          statistics: how far nodes moved, how far they are from S afterwards, inverted tets.
-// Errors   MeshingError if the rim gap exceeds options.max_rim_gap (the message names the rim vertex of
-//          S farthest from S_M), and from the parameterization (rim not one loop, corners impossible, map
+// Errors   UncoveredSurfaceError (a MeshingError) if the rim gap exceeds options.max_rim_gap (the message
+//          names the rim vertex of S farthest from S_M); MeshingError from the parameterization (rim not one loop, corners impossible, map
 //          not one-to-one).
 #pragma once
 
+#include <meccano/error.hpp>
 #include <meccano/geometry/geometry.hpp>
 #include <meccano/mesh/tet_mesh.hpp>
 #include <meccano/stages/parameterization.hpp>
@@ -51,6 +52,12 @@ struct ProjectionOptions {
   double crease_angle = default_crease_angle;  // degrees; creases of S sharper than this are followed (180: none)
   double max_rim_gap =
       std::numeric_limits<double>::infinity();  // physical distance; the pipeline sets a multiple of l_r
+};
+
+// S_M leaves part of S uncovered: its rim gap exceeds ProjectionOptions::max_rim_gap.
+class UncoveredSurfaceError : public MeshingError {
+ public:
+  using MeshingError::MeshingError;
 };
 
 // How far S's rim strays from S_M's: the rim vertex of S farthest from the polyline of S_M's rim, and

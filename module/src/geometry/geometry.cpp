@@ -135,15 +135,6 @@ bool fold_onto_shared_edge(const Triangle3& a, const Triangle3& b) {
   return cosine_part > 0.0 && ua.cross(ub).norm() <= relative_tolerance * cosine_part;
 }
 
-double squared_distance_to_segment(const Vector3d& x, const Vector3d& p0, const Vector3d& p1,
-                                   double* parameter = nullptr) {
-  const Vector3d d = p1 - p0;
-  const double length2 = d.squaredNorm();
-  const double t = length2 > 0.0 ? std::clamp((x - p0).dot(d) / length2, 0.0, 1.0) : 0.0;
-  if (parameter) *parameter = t;
-  return (p0 + t * d - x).squaredNorm();
-}
-
 double squared_segment_distance(const Vector3d& p0, const Vector3d& p1, const Vector3d& q0, const Vector3d& q1) {
   // The minimum is at an endpoint of one segment, or at the interior critical point of both.
   double best = std::min({squared_distance_to_segment(p0, q0, q1), squared_distance_to_segment(p1, q0, q1),
@@ -215,6 +206,15 @@ class TetrahedronTest {
 double corner_angle(const Vector3d& u, const Vector3d& v) { return std::atan2(u.cross(v).norm(), u.dot(v)); }
 
 }  // namespace
+
+double squared_distance_to_segment(const Vector3d& x, const Vector3d& p0, const Vector3d& p1, double* parameter) {
+  const Vector3d d = p1 - p0;
+  const double length2 = d.squaredNorm();
+  const double t = length2 > 0.0 ? std::clamp((x - p0).dot(d) / length2, 0.0, 1.0) : 0.0;
+  if (parameter) *parameter = t;
+  return (p0 + t * d - x).squaredNorm();
+}
+
 
 Eigen::AlignedBox3d bounding_box(std::span<const Eigen::Vector3d> points) {
   Eigen::AlignedBox3d box;

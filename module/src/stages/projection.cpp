@@ -10,16 +10,6 @@
 #include <sstream>
 
 namespace meccano {
-namespace {
-
-double squared_distance_to_segment(const Eigen::Vector3d& x, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const Eigen::Vector3d ab = b - a;
-  const double length_squared = ab.squaredNorm();
-  const double t = length_squared > 0.0 ? std::clamp((x - a).dot(ab) / length_squared, 0.0, 1.0) : 0.0;
-  return (a + t * ab - x).squaredNorm();
-}
-
-}  // namespace
 
 RimGap rim_gap(std::span<const Eigen::Vector3d> surface_points, std::span<const int> surface_rim,
                std::span<const Eigen::Vector3d> approximation_points, std::span<const int> approximation_rim) {

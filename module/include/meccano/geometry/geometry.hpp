@@ -58,6 +58,11 @@ bool triangles_intersect(const Triangle3& a, const Triangle3& b, int shared_corn
 // -value is the penetration depth: the length of the shortest translation that separates them.
 double triangle_separation(const Triangle3& a, const Triangle3& b);
 
+// Squared distance from x to the segment p0-p1; `parameter`, if given, receives the closest point's t in
+// p0 + t (p1 - p0), t in [0, 1] (0 for a degenerate segment).
+double squared_distance_to_segment(const Eigen::Vector3d& x, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+                                   double* parameter = nullptr);
+
 // Euclidean distance between two closed triangles (0 when they intersect).
 double triangle_distance(const Triangle3& a, const Triangle3& b);
 

@@ -18,8 +18,8 @@
 // Output   the moved mesh (tets may be tangled: step 4 untangles them), the parameterizations, and
 //          statistics: how far nodes moved, how far they are from S afterwards, inverted tets.
 // Errors   UncoveredSurfaceError (a MeshingError) if the rim gap exceeds options.max_rim_gap (the message
-//          names the rim vertex of S farthest from S_M); MeshingError from the parameterization (rim not one loop, corners impossible, map
-//          not one-to-one).
+//          names the rim vertex of S farthest from S_M); MeshingError from the parameterization (rim not
+//          one loop, corners impossible, map not one-to-one).
 #pragma once
 
 #include <meccano/error.hpp>
@@ -50,8 +50,8 @@ struct ProjectionStats {
 struct ProjectionOptions {
   FloaterWeights weights = FloaterWeights::mean_value;
   double crease_angle = default_crease_angle;  // degrees; creases of S sharper than this are followed (180: none)
-  double max_rim_gap =
-      std::numeric_limits<double>::infinity();  // physical distance; the pipeline sets a multiple of l_r
+  // Physical distance; the pipeline sets max_rim_gap_in_resolutions l_r (stages/pipeline.hpp).
+  double max_rim_gap = std::numeric_limits<double>::infinity();
 };
 
 // S_M leaves part of S uncovered: its rim gap exceeds ProjectionOptions::max_rim_gap.

@@ -22,11 +22,11 @@
 //          u by the chain rule through dφ/du, and every trial point is located again in φ's parametric
 //          triangulation (a short walk from the last triangle); a step that would fold one of S_M's
 //          triangles in P, or shrink it below 1 % of its area in P when smoothing began, is refused, so
-//          S_M stays embedded in S and no two of its nodes slide onto one point. Rim nodes of S move along their side of
-//          P, that is along the rim of S, and the four corners of P stay fixed: a fixed rim would keep the
-//          chord-length spacing of the projection, which ignores the volume mesh behind it. Nodes on a
-//          crease of S (surface/creases.hpp) move along their crease line of P, strictly inside it: they stay on
-//          the crease edges of S.
+//          S_M stays embedded in S and no two of its nodes slide onto one point. Rim nodes of S move
+//          along their side of P, that is along the rim of S, and the four corners of P stay fixed: a
+//          fixed rim would keep the chord-length spacing of the projection, which ignores the volume mesh
+//          behind it. Nodes on a crease of S (surface/creases.hpp) move along their crease line of P,
+//          strictly inside it: they stay on the crease edges of S.
 // Sweeps   non-linear Gauss-Seidel. Nodes are coloured so that no two nodes of one colour share a tet;
 //          the nodes of a colour are optimised in parallel, so the result does not depend on the thread
 //          count. A node is skipped when neither it nor any node of its star moved (by more than 1 % of

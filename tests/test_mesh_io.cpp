@@ -197,6 +197,50 @@ TEST_P(MshVersions, OverlappingGroupsReadBackWithTheirOwnElements) {
   fs::remove_all(path.parent_path());
 }
 
+// Two node fields on a small meccano: node references (negative for none, as the `sequence` command's
+// previous_node) and plain integers.
+std::array<NodeField, 2> test_node_fields(const TetMesh& mesh) {
+  std::array<NodeField, 2> fields{NodeField{"previous_node", {}, true}, NodeField{"count", {}, false}};
+  for (VertexId v = 0; v < mesh.num_vertices(); ++v) {
+    fields[0].values.push_back(v % 3 == 0 ? -1 : v / 2);
+    fields[1].values.push_back(7 * std::int64_t{v} - 5);
+  }
+  return fields;
+}
+
+// MSH writes each node field as a $NodeData section: Gmsh reads it as a view named like the field, node
+// references in its node tags (the vertex + 1) and -1 for none, other values as they are.
+TEST_P(MshVersions, NodeFieldsReadBackByGmshAsViewsInTheFilesNodeTags) {
+  const TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 2);
+  const auto fields = test_node_fields(mesh);
+  const fs::path path = temporary_directory() / "fields.msh";
+  write_mesh(mesh, standard_groups(mesh), path.string(), {.msh_version = GetParam()}, fields);
+  GmshSession session;
+  gmsh::open(path.string());
+  std::vector<int> views;
+  gmsh::view::getTags(views);
+  ASSERT_EQ(views.size(), 2u);
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    std::string name;
+    gmsh::option::getString("View[" + std::to_string(gmsh::view::getIndex(views[k])) + "].Name", name);
+    EXPECT_EQ(name, fields[k].name);
+    std::string type;
+    std::vector<std::size_t> tags;
+    std::vector<std::vector<double>> data;
+    double time = 0;
+    int components = 0;
+    gmsh::view::getModelData(views[k], 0, type, tags, data, time, components);
+    EXPECT_EQ(type, "NodeData");
+    ASSERT_EQ(tags.size(), static_cast<std::size_t>(mesh.num_vertices()));
+    for (std::size_t i = 0; i < tags.size(); ++i) {
+      const std::int64_t value = fields[k].values[tags[i] - 1];
+      const std::int64_t expected = !fields[k].node_references ? value : value < 0 ? -1 : value + 1;
+      ASSERT_EQ(data[i].at(0), static_cast<double>(expected)) << fields[k].name << " at node tag " << tags[i];
+    }
+  }
+  fs::remove_all(path.parent_path());
+}
+
 INSTANTIATE_TEST_SUITE_P(MeshIo, MshVersions, ::testing::Values(MshVersion::v41, MshVersion::v22),
                          [](const auto& version) { return version.param == MshVersion::v41 ? "msh41" : "msh22"; });
 
@@ -328,6 +372,31 @@ TEST(MeshIo, VtuIsReadBackWithCellsGroupsAndQualities) {
   fs::remove_all(path.parent_path());
 }
 
+// VTU writes each node field as PointData, node references as 0-based point indices; Medit holds no node
+// data and refuses fields; a field of the wrong size is refused before anything is written.
+TEST(MeshIo, NodeFieldsAreVtuPointDataAndMeditRefusesThem) {
+  const TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 2);
+  const auto fields = test_node_fields(mesh);
+  const fs::path dir = temporary_directory();
+  write_mesh(mesh, standard_groups(mesh), (dir / "fields.vtu").string(), {}, fields);
+  const testing::VtuFile vtu = testing::read_vtu((dir / "fields.vtu").string());
+  for (const NodeField& field : fields) {
+    const std::vector<double>& read = vtu.arrays.at(field.name);
+    ASSERT_EQ(read.size(), field.values.size());
+    for (std::size_t v = 0; v < read.size(); ++v) {
+      const std::int64_t value = field.values[v];
+      ASSERT_EQ(read[v], static_cast<double>(field.node_references && value < 0 ? -1 : value)) << field.name;
+    }
+  }
+  fs::remove(dir / "fields.vtu");
+  EXPECT_THROW(write_mesh(mesh, standard_groups(mesh), (dir / "fields.mesh").string(), {}, fields), InputError);
+  NodeField short_field{"short", {1, 2, 3}, false};
+  EXPECT_THROW(write_mesh(mesh, standard_groups(mesh), (dir / "short.msh").string(), {}, {&short_field, 1}),
+               std::invalid_argument);
+  EXPECT_TRUE(fs::is_empty(dir));
+  fs::remove_all(dir);
+}
+
 TEST(MeshIo, TheFormatFollowsTheExtension) {
   EXPECT_EQ(mesh_format_of("out/a.msh"), MeshFormat::msh);
   EXPECT_EQ(mesh_format_of("a.vtu"), MeshFormat::vtu);
@@ -348,8 +417,12 @@ TEST(MeshIo, TheFormatFollowsTheExtension) {
   fs::remove_all(dir);
 }
 
-const std::map<std::string, std::function<void(const TetMesh&, const MeshGroups&, const std::string&)>> writers{
-    {"msh41", write_msh41}, {"msh22", write_msh22}, {"vtu", write_vtu}, {"medit", write_medit}};
+using Writer = std::function<void(const TetMesh&, const MeshGroups&, const std::string&)>;
+const std::map<std::string, Writer> writers{
+    {"msh41", [](const TetMesh& m, const MeshGroups& g, const std::string& p) { write_msh41(m, g, p); }},
+    {"msh22", [](const TetMesh& m, const MeshGroups& g, const std::string& p) { write_msh22(m, g, p); }},
+    {"vtu", [](const TetMesh& m, const MeshGroups& g, const std::string& p) { write_vtu(m, g, p); }},
+    {"medit", write_medit}};
 
 TEST(MeshIo, InvalidGroupsAreRejectedBeforeAnythingIsWritten) {
   const TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);

@@ -66,10 +66,23 @@ void write_physical_names(TextWriter& out, const MeshGroups& groups) {
 
 void write_point(TextWriter& out, const Eigen::Vector3d& p) { out << p.x() << ' ' << p.y() << ' ' << p.z() << '\n'; }
 
+// The same in both versions: a $NodeData section per field, at time 0 and step 0, nodes tagged v + 1.
+void write_node_data(TextWriter& out, std::span<const NodeField> node_fields) {
+  for (const NodeField& field : node_fields) {
+    const auto nodes = static_cast<std::int64_t>(field.values.size());
+    out << "$NodeData\n1\n\"" << std::string_view(field.name) << "\"\n1\n0\n3\n0\n1\n" << nodes << '\n';
+    for (std::int64_t v = 0; v < nodes; ++v)
+      out << v + 1 << ' ' << mesh_io::written_value(field, field.values[v], 1) << '\n';
+    out << "$EndNodeData\n";
+  }
+}
+
 }  // namespace
 
-void write_msh41(const TetMesh& mesh, const MeshGroups& groups, const std::string& path) {
+void write_msh41(const TetMesh& mesh, const MeshGroups& groups, const std::string& path,
+                 std::span<const NodeField> node_fields) {
   mesh_io::check_groups(mesh, groups);
+  mesh_io::check_node_fields(mesh, node_fields);
   std::vector<std::vector<std::int64_t>> tet_keys, face_keys;
   for (const auto& g : groups.volumes) tet_keys.emplace_back(g.tets.begin(), g.tets.end());
   for (const auto& g : groups.surfaces) {
@@ -140,11 +153,14 @@ void write_msh41(const TetMesh& mesh, const MeshGroups& groups, const std::strin
       }
     }
     out << "$EndElements\n";
+    write_node_data(out, node_fields);
   });
 }
 
-void write_msh22(const TetMesh& mesh, const MeshGroups& groups, const std::string& path) {
+void write_msh22(const TetMesh& mesh, const MeshGroups& groups, const std::string& path,
+                 std::span<const NodeField> node_fields) {
   mesh_io::check_groups(mesh, groups);
+  mesh_io::check_node_fields(mesh, node_fields);
   write_file_atomically(path, [&](std::ostream& stream) {
     TextWriter out(stream);
     out << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
@@ -170,6 +186,7 @@ void write_msh22(const TetMesh& mesh, const MeshGroups& groups, const std::strin
     mesh_io::for_each_group_triangle(mesh, groups, [&](int tag, const auto& face) { element(2, tag, face); });
     mesh_io::for_each_group_tet(mesh, groups, [&](int tag, TetId, const auto& tet) { element(4, tag, tet); });
     out << "$EndElements\n";
+    write_node_data(out, node_fields);
   });
 }
 

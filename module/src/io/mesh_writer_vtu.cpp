@@ -99,8 +99,10 @@ std::string xml_escaped(std::string_view text) {
 
 }  // namespace
 
-void write_vtu(const TetMesh& mesh, const MeshGroups& groups, const std::string& path) {
+void write_vtu(const TetMesh& mesh, const MeshGroups& groups, const std::string& path,
+               std::span<const NodeField> node_fields) {
   mesh_io::check_groups(mesh, groups);
+  mesh_io::check_node_fields(mesh, node_fields);
   std::vector<double> meccano_quality(mesh.tets.size()), equilateral_quality(mesh.tets.size());
 #pragma omp parallel for schedule(static)
   for (TetId t = 0; t < mesh.num_tets(); ++t) {
@@ -169,7 +171,13 @@ void write_vtu(const TetMesh& mesh, const MeshGroups& groups, const std::string&
     write_data_array<double>(
         out, "Name=\"quality_equilateral\"", tets + triangles,
         per_cell([&](int, TetId t) { return equilateral_quality[t]; }, [](int) { return triangle_quality; }));
-    out << "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+    out << "</CellData>\n<PointData>\n";
+    for (const NodeField& field : node_fields)
+      write_data_array<std::int64_t>(out, "Name=\"" + xml_escaped(field.name) + "\"", mesh.num_vertices(),
+                                     [&](auto put) {
+        for (const std::int64_t value : field.values) put(mesh_io::written_value(field, value, 0));
+      });
+    out << "</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
   });
 }
 

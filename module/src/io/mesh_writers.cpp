@@ -14,13 +14,28 @@
 namespace meccano {
 namespace mesh_io {
 
+namespace {
+
+// `what` names the kind of thing named: "mesh group", "node field".
+void check_name(const std::string& name, const char* what) {
+  if (name.empty()) throw std::invalid_argument(std::string(what) + ": empty name");
+  for (const char c : name)
+    if (c == '"' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+      throw std::invalid_argument(std::string(what) + " '" + name + "': names may not hold '\"' or control characters");
+}
+
+}  // namespace
+
+void check_node_fields(const TetMesh& mesh, std::span<const NodeField> node_fields) {
+  for (const NodeField& field : node_fields) {
+    check_name(field.name, "node field");
+    if (field.values.size() != mesh.points.size())
+      throw std::invalid_argument("node field " + field.name + ": " + std::to_string(field.values.size()) +
+                                  " values for " + std::to_string(mesh.points.size()) + " nodes");
+  }
+}
+
 void check_groups(const TetMesh& mesh, const MeshGroups& groups) {
-  auto check_name = [](const std::string& name) {
-    if (name.empty()) throw std::invalid_argument("mesh groups: a group has an empty name");
-    for (const char c : name)
-      if (c == '"' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
-        throw std::invalid_argument("mesh group '" + name + "': names may not hold '\"' or control characters");
-  };
   auto check_tet = [&](const std::string& name, TetId t) {
     if (t < 0 || t >= mesh.num_tets())
       throw std::invalid_argument("mesh group " + name + ": tet " + std::to_string(t) + " does not exist (" +
@@ -40,11 +55,11 @@ void check_groups(const TetMesh& mesh, const MeshGroups& groups) {
   check_tags(groups.volumes, "3D");
   check_tags(groups.surfaces, "2D");
   for (const TetGroup& group : groups.volumes) {
-    check_name(group.name);
+    check_name(group.name, "mesh group");
     for (const TetId t : group.tets) check_tet(group.name, t);
   }
   for (const FaceGroup& group : groups.surfaces) {
-    check_name(group.name);
+    check_name(group.name, "mesh group");
     for (const FaceRef& face : group.faces) {
       check_tet(group.name, face.tet);
       if (face.local_face < 0 || face.local_face > 3)
@@ -115,18 +130,23 @@ std::optional<MeshFormat> mesh_format_of(const std::string& path) {
   return std::nullopt;
 }
 
-void write_mesh(const TetMesh& mesh, const MeshGroups& groups, const std::string& path,
-                const MeshWriteOptions& options) {
+void write_mesh(const TetMesh& mesh, const MeshGroups& groups, const std::string& path, const MeshWriteOptions& options,
+                std::span<const NodeField> node_fields) {
   const std::optional<MeshFormat> format = mesh_format_of(path);
   if (!format)
     throw InputError("cannot write " + path + ": unknown mesh format (the extensions are .msh, .vtu and .mesh)");
   switch (*format) {
     case MeshFormat::msh:
-      if (options.msh_version == MshVersion::v22) write_msh22(mesh, groups, path);
-      else write_msh41(mesh, groups, path);
+      if (options.msh_version == MshVersion::v22) write_msh22(mesh, groups, path, node_fields);
+      else write_msh41(mesh, groups, path, node_fields);
       return;
-    case MeshFormat::vtu: write_vtu(mesh, groups, path); return;
-    case MeshFormat::medit: write_medit(mesh, groups, path); return;
+    case MeshFormat::vtu: write_vtu(mesh, groups, path, node_fields); return;
+    case MeshFormat::medit:
+      if (!node_fields.empty())
+        throw InputError("cannot write " + path + ": a Medit file holds no node data (node field " +
+                         node_fields.front().name + "); write .msh or .vtu");
+      write_medit(mesh, groups, path);
+      return;
   }
 }
 

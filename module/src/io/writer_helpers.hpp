@@ -60,6 +60,15 @@ class TextWriter {
 // group's name cannot be written in every format.
 void check_groups(const TetMesh& mesh, const MeshGroups& groups);
 
+// std::invalid_argument unless every field has a valid name and one value per node of `mesh`.
+void check_node_fields(const TetMesh& mesh, std::span<const NodeField> node_fields);
+
+// A field's value as written in a format whose first node is numbered `first_node` (MSH 1, VTU 0).
+inline std::int64_t written_value(const NodeField& field, std::int64_t value, std::int64_t first_node) {
+  if (!field.node_references) return value;
+  return value < 0 ? -1 : value + first_node;
+}
+
 // Elements counted once per group they are in.
 std::int64_t group_tet_count(const MeshGroups& groups);
 std::int64_t group_triangle_count(const MeshGroups& groups);

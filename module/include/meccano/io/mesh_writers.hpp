@@ -36,12 +36,23 @@
 //          its first 3D group (`domain`: 1); a face once per 2D group, with reference = that group's tag.
 //          Comment lines after the header name the references: `# Tetrahedra ref 1 domain`,
 //          `# Triangles ref 7 interface_patch`.
+// Node fields (optional): integer values per node, such as the `sequence` command's `previous_node`.
+//   .msh   a $NodeData section per field after $Elements (both versions; Gmsh shows each as a view):
+//          string tag the field's name, real tag the time 0, integer tags step 0, 1 component, the
+//          node count; then one line per node: its tag and value.
+//   .vtu   PointData, an Int64 array per field named like it.
+//   .mesh  Medit holds no node data: write_mesh refuses node fields for it.
+//   A field of node references (NodeField::node_references) holds nodes of some mesh, or a negative
+//   value for none; each format writes them in its own node numbering (MSH's node tags, VTU's 0-based
+//   point indices), and none as -1.
 // Writes are atomic (io/atomic_file.hpp): a failed write leaves no file; InputError names the path.
 #pragma once
 
 #include <meccano/mesh/tet_mesh.hpp>
 
+#include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -64,15 +75,25 @@ struct MeshGroups {
   std::vector<FaceGroup> surfaces;
 };
 
+// One value per node; the name follows the group names' rules (not empty, no '"' nor control characters).
+struct NodeField {
+  std::string name;
+  std::vector<std::int64_t> values;
+  bool node_references = false;  // values are VertexIds of some mesh (negative: none), renumbered per format
+};
+
 // `domain`, the six box sides, and `interface_NAME` for every interface tag in use, NAME taken from
 // `interface_names` (index = interface index), numbered as above. Interface faces are oriented out of the tet on the side
 // of the face where the tag was set first in tet order; stages that know the surface's normal build
 // their own group instead.
 MeshGroups standard_groups(const TetMesh& mesh, const std::vector<std::string>& interface_names = {});
 
-void write_msh41(const TetMesh& mesh, const MeshGroups& groups, const std::string& path);
-void write_msh22(const TetMesh& mesh, const MeshGroups& groups, const std::string& path);
-void write_vtu(const TetMesh& mesh, const MeshGroups& groups, const std::string& path);
+void write_msh41(const TetMesh& mesh, const MeshGroups& groups, const std::string& path,
+                 std::span<const NodeField> node_fields = {});
+void write_msh22(const TetMesh& mesh, const MeshGroups& groups, const std::string& path,
+                 std::span<const NodeField> node_fields = {});
+void write_vtu(const TetMesh& mesh, const MeshGroups& groups, const std::string& path,
+               std::span<const NodeField> node_fields = {});
 void write_medit(const TetMesh& mesh, const MeshGroups& groups, const std::string& path);
 
 enum class MeshFormat { msh, vtu, medit };
@@ -86,8 +107,8 @@ struct MeshWriteOptions {
 std::optional<MeshFormat> mesh_format_of(const std::string& path);
 
 // Writes with the writer of the path's extension. Throws InputError naming the path if the extension is
-// not one of .msh, .vtu, .mesh (nothing is written then).
+// not one of .msh, .vtu, .mesh, or if node fields are given for a .mesh file (nothing is written then).
 void write_mesh(const TetMesh& mesh, const MeshGroups& groups, const std::string& path,
-                const MeshWriteOptions& options = {});
+                const MeshWriteOptions& options = {}, std::span<const NodeField> node_fields = {});
 
 }  // namespace meccano

@@ -1,6 +1,7 @@
 #include <meccano/stages/pipeline.hpp>
 
 #include <meccano/error.hpp>
+#include <meccano/geometry/geometry.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/mesh/invariants.hpp>
 
@@ -255,6 +256,21 @@ void lift_worst_tets(InsertionResult& result, std::span<SurfaceProjection* const
   report_improvement(options, improvement, improved);
 }
 
+// Step 4 and the improvement after it. False, and the mesh as SUS left it, if tets stay inverted.
+bool untangle_smooth_and_improve(InsertionResult& result, const InsertionOptions& options) {
+  std::vector<SurfaceProjection*> projections;
+  for (SurfaceInsertion& inserted : result.surfaces) projections.push_back(&inserted.projection);
+  untangle_and_smooth(result, projections, options);
+  if (!result.smoothing.untangled()) return false;
+  check_stage(result.mesh, "smoothing");
+  if (options.improve != Improvement::none) {
+    lift_worst_tets(result, projections, options);
+    check_stage(result.mesh, "improvement");
+  }
+  result.quality_after_smoothing = summarize_quality(result.mesh);
+  return true;
+}
+
 InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfaces, const InsertionOptions& options,
                            std::span<const SideRule> side_rules, std::span<const double> resolutions,
                            bool require_coverage) {
@@ -279,17 +295,7 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
   result.quality_before_smoothing = summarize_quality(result.mesh);
   if (options.last_stage == Stage::projection) return result;
 
-  std::vector<SurfaceProjection*> projections;
-  for (SurfaceInsertion& inserted : result.surfaces) projections.push_back(&inserted.projection);
-  untangle_and_smooth(result, projections, options);
-  if (!result.smoothing.untangled()) return result;  // the caller may retry, or reports the failure
-  check_stage(result.mesh, "smoothing");
-
-  if (options.improve != Improvement::none) {
-    lift_worst_tets(result, projections, options);
-    check_stage(result.mesh, "improvement");
-  }
-  result.quality_after_smoothing = summarize_quality(result.mesh);
+  untangle_smooth_and_improve(result, options);  // if tets stay inverted, the caller may retry or reports it
   return result;
 }
 
@@ -690,6 +696,137 @@ std::vector<SurfaceInterface> surface_interfaces(const InsertionResult& result) 
     }
   }
   return interfaces;
+}
+
+namespace {
+
+// φ of the moved surface: the previous step's parameterization (the parameters of S's vertices in P) over
+// the surface's new positions. Throws InputError unless the parametric triangles of `moved` still tile P
+// as the previous ones did, which holds when the triangulation is the same.
+std::unique_ptr<ParametricSurface> moved_parameterization(const ParametricSurface& previous,
+                                                          const TriangleSurface& moved) {
+  const SquareParameterization& parameterization = previous.parameterization();
+  const auto defect = [&](const std::string& what) {
+    return InputError("surface " + moved.name + ": its triangulation is not the one of the previous step (" + what +
+                      "); only its points may move");
+  };
+  if (moved.points.size() != parameterization.uv.size() ||
+      static_cast<int>(moved.triangles.size()) != previous.triangle_count())
+    throw defect(std::to_string(moved.points.size()) + " points and " + std::to_string(moved.triangles.size()) +
+                 " triangles, against " + std::to_string(parameterization.uv.size()) + " and " +
+                 std::to_string(previous.triangle_count()));
+  for (std::size_t t = 0; t < moved.triangles.size(); ++t) {
+    const auto& [a, b, c] = moved.triangles[t];
+    const Eigen::Vector2d& ua = parameterization.uv[a];
+    if (parameterization.orientation * cross2(parameterization.uv[b] - ua, parameterization.uv[c] - ua) <= 0.0)
+      throw defect("triangle " + std::to_string(t + 1) + " is flipped or flat in the previous parameterization");
+  }
+  return std::make_unique<ParametricSurface>(DiskView(moved), parameterization);
+}
+
+// Every node within `rings` edge rings of a moved node (`moved`, with its `displacement`) but not moved
+// itself follows it: by the mean displacement of its neighbours in the rings before, times
+// 1 - k / (rings + 1) in ring k, along the axes the box leaves it. The tets beside the interface then keep
+// their shape instead of being squeezed or inverted, and SUS has less to do.
+void drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector<Eigen::Vector3d> displacement,
+                     int rings) {
+  const VertexTets stars = vertex_to_tets(mesh);
+  const GridPoint upper = mesh.meccano.upper_corner();
+  std::vector<VertexId> frontier;
+  for (VertexId v = 0; v < mesh.num_vertices(); ++v)
+    if (moved[v]) frontier.push_back(v);
+  for (int ring = 1; ring <= rings && !frontier.empty(); ++ring) {
+    std::vector<VertexId> next;
+    for (const VertexId v : frontier)
+      for (const TetId t : stars.of(v))
+        for (const VertexId w : mesh.tets[t])
+          if (!moved[w]) {
+            moved[w] = 2;  // found in this ring
+            next.push_back(w);
+          }
+    std::ranges::sort(next);
+    next.erase(std::unique(next.begin(), next.end()), next.end());
+    const double share = 1.0 - static_cast<double>(ring) / (rings + 1);
+    for (const VertexId w : next) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int count = 0;
+      for (const TetId t : stars.of(w))
+        for (const VertexId u : mesh.tets[t])
+          if (moved[u] == 1) {
+            sum += displacement[u];
+            ++count;
+          }
+      Eigen::Vector3d d = share * sum / count;
+      for (int axis = 0; axis < 3; ++axis)
+        if (mesh.grid[w][axis] == 0 || mesh.grid[w][axis] == upper[axis]) d[axis] = 0.0;
+      displacement[w] = d;
+    }
+    for (const VertexId w : next) {
+      moved[w] = 1;
+      mesh.points[w] += displacement[w];
+    }
+    frontier = std::move(next);
+  }
+}
+
+}  // namespace
+
+InsertionResult move_surfaces(const InsertionResult& previous, std::span<const TriangleSurface> surfaces,
+                              const InsertionOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (surfaces.size() != previous.surfaces.size())
+    throw InputError(std::to_string(surfaces.size()) + " surfaces to move, but the previous step inserted " +
+                     std::to_string(previous.surfaces.size()));
+  const ThreadCount threads(options.threads);
+  InsertionResult result;
+  result.mesh = previous.mesh;
+  result.estimated_tets = previous.estimated_tets;
+  std::vector<std::uint8_t> moved_node(result.mesh.points.size(), 0);
+  std::vector<Eigen::Vector3d> displacement(result.mesh.points.size(), Eigen::Vector3d::Zero());
+  for (std::size_t s = 0; s < surfaces.size(); ++s) {
+    const auto moving = std::chrono::steady_clock::now();
+    const SurfaceInsertion& was = previous.surfaces[s];
+    SurfaceInsertion& moved = result.surfaces.emplace_back();
+    moved.name = was.name;
+    moved.resolution = was.resolution;
+    moved.volumetric = was.volumetric;
+    moved.volumetric_stats = was.volumetric_stats;
+    moved.healing_stats = was.healing_stats;
+    const SurfaceProjection& from = was.projection;
+    SurfaceProjection& to = moved.projection;
+    to.surface = moved_parameterization(*from.surface, surfaces[s]);
+    to.nodes = from.nodes;
+    to.uv = from.uv;
+    to.on_rim = from.on_rim;
+    to.triangles = from.triangles;
+    to.orientation = from.orientation;
+    to.creases = from.creases;
+    to.stats.nodes = from.stats.nodes;
+    to.stats.rim_nodes = from.stats.rim_nodes;
+    to.stats.creases = from.stats.creases;
+    for (std::size_t i = 0; i < to.nodes.size(); ++i) {
+      Eigen::Vector3d& node = result.mesh.points[to.nodes[i]];
+      const Eigen::Vector3d on_surface = to.surface->evaluate(to.surface->locate(to.uv[i]));
+      displacement[to.nodes[i]] = on_surface - node;
+      moved_node[to.nodes[i]] = 1;
+      to.stats.largest_move = std::max(to.stats.largest_move, (on_surface - node).norm());
+      node = on_surface;
+    }
+    moved.projection_seconds = seconds_since(moving);
+  }
+  if (options.smoothing.mode == SmoothingMode::band)
+    drag_neighbours(result.mesh, std::move(moved_node), std::move(displacement), options.smoothing.band_rings - 1);
+  const std::int64_t inverted = count_inverted(result.mesh);
+  for (SurfaceInsertion& moved : result.surfaces) {
+    moved.projection.stats.inverted_tets = inverted;
+    report(options, "moved ", moved.name, ": ", moved.projection.nodes.size(), " S_M nodes by up to ",
+           moved.projection.stats.largest_move, "; ", inverted, " tets inverted");
+  }
+  result.quality_before_smoothing = summarize_quality(result.mesh);
+  if (!untangle_smooth_and_improve(result, options))
+    throw MeshingError("the moved interface leaves " + tets_still_inverted(result));
+  result.seconds = seconds_since(start);
+  return result;
 }
 
 }  // namespace meccano

@@ -121,6 +121,18 @@ struct InsertionResult {
 InsertionResult insert_surfaces(const TetMesh& mesh, std::span<const TriangleSurface> surfaces,
                                 const InsertionOptions& options);
 
+// A moving surface's next step (issue 20) from the previous step's result, without a new insertion: the
+// surfaces have the triangulations they were inserted (or last moved) with, in the same order, and only
+// their points moved. Each S_M node keeps its parameters u in P and goes to φ(u), φ the previous step's
+// parameterization over the moved surface (the parameters of S's vertices kept, their positions new); then
+// step 4 and the improvement run as in insert_surfaces, SUS in options.smoothing's mode (in a band, only
+// the nodes near the interface move: the rest of the mesh is the previous step's, node for node). The
+// topology, refinement and V_M are the previous step's. No retry: an interface that moved too far for SUS
+// throws MeshingError, and the caller inserts the surfaces anew (stages/sequence.hpp). Throws InputError if
+// a surface's triangulation differs.
+InsertionResult move_surfaces(const InsertionResult& previous, std::span<const TriangleSurface> surfaces,
+                              const InsertionOptions& options);
+
 // `domain`, the box sides, and `interface_NAME` for every surface's S_M (once built), oriented like the
 // surface; at the inspection stages (last_stage before smoothing) also `volumetric_NAME` for every
 // surface's V_M. Tags as in io/mesh_writers.hpp: surface k's interface is 7 + k whichever S_M exist, its V_M

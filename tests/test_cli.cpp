@@ -344,6 +344,105 @@ TEST_F(CliTest, FullPipelineWritesAnUntangledMeshAReportAndHistograms) {
                     "after_smoothing_equilateral");
 }
 
+// The node tags and coordinates of an MSH file, and its views' data by view name and node tag.
+struct MshNodes {
+  std::map<std::size_t, Eigen::Vector3d> points;
+  std::map<std::string, std::map<std::size_t, double>> views;
+};
+
+MshNodes read_nodes_and_views(const std::string& file) {
+  gmsh::initialize();
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::open(file);
+  MshNodes read;
+  std::vector<std::size_t> tags;
+  std::vector<double> coords, parametric;
+  gmsh::model::mesh::getNodes(tags, coords, parametric);
+  for (std::size_t i = 0; i < tags.size(); ++i)
+    read.points[tags[i]] = {coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]};
+  std::vector<int> views;
+  gmsh::view::getTags(views);
+  for (const int view : views) {
+    std::string name, type;
+    gmsh::option::getString("View[" + std::to_string(gmsh::view::getIndex(view)) + "].Name", name);
+    std::vector<std::size_t> nodes;
+    std::vector<std::vector<double>> data;
+    double time = 0;
+    int components = 0;
+    gmsh::view::getModelData(view, 0, type, nodes, data, time, components);
+    for (std::size_t i = 0; i < nodes.size(); ++i) read.views[name][nodes[i]] = data[i].at(0);
+  }
+  gmsh::finalize();
+  return read;
+}
+
+// A patch raised by a quarter of l_r per step: one file per step, every step checked, and each node's
+// previous_node a node of the previous step's file at the same position; the report counts them.
+TEST_F(CliTest, SequenceWritesEveryStepWithItsPreviousNodesAndAReport) {
+  std::string steps;
+  for (int k = 0; k < 3; ++k) {
+    TriangleSurface patch = testing::paper_like_patch(10);
+    for (Eigen::Vector3d& p : patch.points) p.z() += k * 0.0625 / 4;
+    steps += " --step " + write_obj("patch_" + std::to_string(k) + ".obj", patch) + ":fault";
+  }
+  const CliRun run =
+      run_cli("sequence --box 0,0,0,1,1,1 --level 3 --resolution 0.0625" + steps + " --output " +
+              path("fault_{step}.msh") + " --output " + path("fault_{step}.vtu") + " --report " + path("steps.json"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  for (const char* line : {"step 0: inserted", "step 1: moved", "step 2: moved"})
+    EXPECT_NE(run.output.find(line), std::string::npos) << line << "\n" << run.output;
+  std::ifstream report_file(path("steps.json"));
+  const std::string report((std::istreambuf_iterator<char>(report_file)), std::istreambuf_iterator<char>());
+  for (const char* key : {"\"steps\"", "\"step\": 2", "\"mode\": \"moved\"", "\"seconds\"", "\"tets\"", "\"nodes\"",
+                          "\"nodes_unchanged\"", "\"quality\"", "\"min_dihedral_deg\"", "\"insertion\""})
+    EXPECT_NE(report.find(key), std::string::npos) << key << " missing from\n" << report;
+
+  MshNodes previous;
+  for (int k = 0; k < 3; ++k) {
+    const std::string file = path("fault_" + std::to_string(k) + ".msh");
+    EXPECT_EQ(run_cli("check " + file + " --quiet").status, 0) << file;
+    EXPECT_TRUE(fs::exists(path("fault_" + std::to_string(k) + ".vtu")));
+    const MshNodes step = read_nodes_and_views(file);
+    ASSERT_EQ(step.views.count("previous_node"), 1u);
+    std::size_t unchanged = 0;
+    for (const auto& [tag, previous_tag] : step.views.at("previous_node")) {
+      if (previous_tag < 0) continue;
+      ASSERT_GT(k, 0) << "step 0 has no previous step";
+      ++unchanged;
+      ASSERT_EQ(previous.points.at(static_cast<std::size_t>(previous_tag)), step.points.at(tag)) << "node " << tag;
+    }
+    const std::string counted = "\"nodes_unchanged\": " + std::to_string(unchanged);
+    EXPECT_NE(report.find(counted), std::string::npos) << "step " << k << ": " << counted;
+    previous = step;
+  }
+}
+
+TEST_F(CliTest, SequenceRefusesWhatItCannotDoAndWritesNothing) {
+  const std::string patch = write_obj("patch.obj", testing::paper_like_patch(10));
+  const std::string start = "sequence --box 0,0,0,1,1,1 --level 3 --resolution 0.0625 ";
+  const std::map<std::string, std::string> usage{
+      {start + "--output " + path("a.msh"), "sequence needs at least one --step"},
+      {start + "--step " + patch + " --output " + path("a.msh"), "must hold {step}"},
+      {start + "--step " + patch + " --output " + path("a_{step}.mesh"), "a Medit file holds no node data"},
+      {start + "--step " + patch + ":a --step " + patch + ":b --output " + path("a_{step}.msh"),
+       "every step names the same surfaces in the same order"},
+      {start + "--step " + patch + ", --output " + path("a_{step}.msh"), "an empty surface between commas"},
+      {start + "--step " + patch + " --stage volumetric --output " + path("a_{step}.msh"), "--stage and --histograms"},
+  };
+  for (const auto& [arguments, message] : usage) {
+    const CliRun run = run_cli(arguments);
+    EXPECT_EQ(run.status, 2) << arguments << "\n" << run.output;
+    EXPECT_NE(run.output.find(message), std::string::npos) << arguments << "\n" << run.output;
+  }
+  // A bad file in a later step fails the run before any meshing, naming the step; nothing is written.
+  const CliRun missing =
+      run_cli(start + "--step " + patch + " --step " + path("none.obj") + " --output " + path("a_{step}.msh"));
+  EXPECT_EQ(missing.status, 1) << missing.output;
+  EXPECT_NE(missing.output.find("step 1: "), std::string::npos) << missing.output;
+  EXPECT_EQ(missing.output.find("meccano: 48 tets, "), std::string::npos) << "meshed before reading every step";
+  EXPECT_TRUE(only_inputs_in_directory(1));
+}
+
 // An insertion that fails after its retries (one sweep cannot untangle the projected patch, on either
 // side, at l_r and at l_r / 2) lists each attempt on one line, with its l_r and side rule, and says once
 // what the failure means and what may mend it.

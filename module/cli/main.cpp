@@ -12,11 +12,13 @@
 #include <meccano/report/insertion_report.hpp>
 #include <meccano/report/quality_csv.hpp>
 #include <meccano/stages/pipeline.hpp>
+#include <meccano/stages/sequence.hpp>
 #include <meccano/surface/validation.hpp>
 
 #include "arguments.hpp"
 #include "tool_support.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <chrono>
@@ -25,6 +27,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -34,6 +37,8 @@
 namespace {
 
 constexpr const char* usage_text = R"(Usage: meccano-immerse --box X0,Y0,Z0,X1,Y1,Z1 [options] --output FILE
+       meccano-immerse sequence --box X0,Y0,Z0,X1,Y1,Z1 --resolution L --step FILE[:NAME][,...]
+                                --step ... [options] --output PATTERN
        meccano-immerse check FILE.msh [--report FILE.json] [--quiet]
        meccano-immerse measure FILE.msh [--surface FILE[:NAME] ...] [--report FILE.json] [--quiet]
 
@@ -127,6 +132,22 @@ Options:
   --quiet                  no progress output
   --help                   this text
 
+sequence inserts the surfaces of a moving interface step after step, each --step giving the positions
+of one step's surfaces (FILE[:NAME] separated by commas; every step names the same surfaces in the same
+order), into the meccano mesh of --box, --cells and --level, and writes each step's mesh to every
+--output PATTERN with {step} replaced by 0, 1, ... (.msh or .vtu: Medit files hold no node data). Each
+mesh carries the node data `previous_node`: for every node, the node of the previous step's mesh at the
+same position, bit for bit, or -1 (in .msh files the previous file's node tag, in .vtu files its
+0-based point index; -1 everywhere at step 0), so that a solver can carry its solution over. SUS works
+in a band around the surfaces by default (--smoothing band), so that the mesh away from them stays
+node for node the same. The options of the one-shot command apply, but for --surface, --split-parts,
+--stage and --histograms. Every step is read and validated before any meshing; the files appear
+together once every step is done. Progress: one line per step. --report FILE.json writes one object per
+step under `steps` (step, seconds, tets, nodes, nodes_unchanged, quality with meccano and equilateral
+min/mean/std, inverted, min_dihedral_deg, max_dihedral_deg, and the step's whole report under
+`insertion`) and the total `seconds`. Each step is inserted into the meccano mesh anew; the incremental
+update that reuses the previous step's mesh is not implemented yet.
+
 check FILE.msh checks the invariants of a tet mesh of a box in any Gmsh MSH file (2.2 or 4.1, ASCII or
 binary; this tool's, Gmsh's, ...): conformity, orientation, volume, the box sides xmin ... zmax (if the
 file has those groups) and every interface_* group (interior faces forming a consistently oriented
@@ -157,6 +178,9 @@ Examples:
                   --resolution 350 --output fault.msh               (a GOCAD TSurf fault in UTM metres)
   meccano-immerse --box 0,0,0,1,1,1 --surface faults.ts:f --split-parts --resolution 0.03 \
                   --output faults.msh                               (surfaces f_1, f_2, ... per part)
+  meccano-immerse sequence --box 0,0,0,1,1,1 --level 6 --resolution 0.03 --step patch_0.obj:fault \
+                  --step patch_1.obj:fault --step patch_2.obj:fault --output out/fault_{step}.msh \
+                  --report steps.json                               (a moving fault, 3 steps)
   meccano-immerse check fault.msh --report fault_check.json
   meccano-immerse measure fault.msh --surface patch.obj:fault --report fault_measure.json
 )";
@@ -204,8 +228,8 @@ ArgumentParser::ValueHandler store_integer(const std::string& option, Int& targe
   };
 }
 
-// The box, its meccano mesh and the surfaces to insert.
-void declare_input_options(ArgumentParser& parser, Options& options) {
+// The box, its meccano mesh and the resolution near the surfaces.
+void declare_mesh_options(ArgumentParser& parser, Options& options) {
   parser.required_value({"--box"}, [&](const std::string& text) {
     const auto v = meccano::tools::parse_numbers("--box", text, 6);
     options.box = meccano::tools::box_from_numbers("--box", {v[0], v[1], v[2], v[3], v[4], v[5]});
@@ -224,21 +248,25 @@ void declare_input_options(ArgumentParser& parser, Options& options) {
     options.level = meccano::tools::parse_integer("--level", text);
     if (options.level < 0 || options.level > 40) throw UsageError("--level must be between 0 and 40");
   });
-  parser.value({"--surface"}, [&](const std::string& text) {
-    options.surfaces.push_back(meccano::tools::parse_surface_argument(text, options.surfaces.size() + 1));
-  });
   // Single numbers go through the comma-separated reader, as they always did: "1," reads as 1.
   parser.value({"--weld-tolerance"}, [&](const std::string& text) {
     const double tolerance = meccano::tools::parse_numbers("--weld-tolerance", text, 1)[0];
     if (tolerance < 0) throw UsageError("--weld-tolerance must not be negative");
     options.reading.weld_tolerance = tolerance;
   });
-  parser.flag({"--split-parts"}, [&] { options.split_parts = true; });
   parser.value({"--resolution"}, [&](const std::string& text) {
     const double l = meccano::tools::parse_numbers("--resolution", text, 1)[0];
     if (!(l > 0)) throw UsageError("--resolution must be positive");
     options.resolution = l;
   });
+}
+
+// The surfaces to insert, for the one-shot command.
+void declare_surface_options(ArgumentParser& parser, Options& options) {
+  parser.value({"--surface"}, [&](const std::string& text) {
+    options.surfaces.push_back(meccano::tools::parse_surface_argument(text, options.surfaces.size() + 1));
+  });
+  parser.flag({"--split-parts"}, [&] { options.split_parts = true; });
 }
 
 // How the surfaces are inserted: the stages, their choices and limits.
@@ -344,7 +372,8 @@ Options parse_options(int argc, char** argv) {
   bool msh_version_unused = false;
   ArgumentParser parser;
   parser.help(usage_text);
-  declare_input_options(parser, options);
+  declare_mesh_options(parser, options);
+  declare_surface_options(parser, options);
   declare_method_options(parser, options);
   declare_output_options(parser, options, output_format, msh_version_unused);
   parser.parse({argv + 1, argv + argc});
@@ -367,10 +396,11 @@ std::string welding_summary(const meccano::SurfaceReadReport& report) {
   return summary;
 }
 
-// The surfaces of the --surface options, named; with --split-parts, one per part of each file.
-std::vector<meccano::TriangleSurface> read_surfaces(const Options& options, const Progress& progress) {
+// The surfaces of `files` ((file, name) pairs), named; with --split-parts, one per part of each file.
+std::vector<meccano::TriangleSurface> read_surfaces(const std::vector<std::pair<std::string, std::string>>& files,
+                                                    const Options& options, const Progress& progress) {
   std::vector<meccano::TriangleSurface> surfaces;
-  for (const auto& [file, name] : options.surfaces) {
+  for (const auto& [file, name] : files) {
     meccano::SurfaceReadReport report;
     if (!options.split_parts) {
       meccano::TriangleSurface& surface = surfaces.emplace_back(meccano::read_surface(file, options.reading, &report));
@@ -392,13 +422,8 @@ std::vector<meccano::TriangleSurface> read_surfaces(const Options& options, cons
   return surfaces;
 }
 
-int run(const Options& options) {
-  // Every file the run writes, checked before any work: a mistyped path must not cost a meshing run.
-  for (const auto& output : options.outputs) meccano::require_writable(output.path);
-  for (const auto& path : {options.histograms, options.report})
-    if (path) meccano::require_writable(*path);
-  const Progress progress(options.quiet);
-  if (options.threads) omp_set_num_threads(*options.threads);
+// The cells of the box's meccano, once its tet count is known to be within --max-tets.
+std::array<int, 3> meccano_cells(const Options& options, const Progress& progress) {
   const auto cells = options.cells ? *options.cells : meccano::cells_for_box(options.box);
   // In floating point: 1024 cells a side at level 40 would overflow 64 bits, and the limit must still refuse it.
   const double tets = 6.0 * cells[0] * cells[1] * cells[2] * std::ldexp(1.0, options.level);
@@ -406,14 +431,11 @@ int run(const Options& options) {
   progress.say("meccano: ", cells[0], "x", cells[1], "x", cells[2], " cells, level ", options.level, ", ",
                expected_tets, " tets");
   meccano::require_tet_estimate_within(expected_tets, options.max_tets, "the meccano mesh (--cells, --level)");
-  // Read and validate every surface before any meshing: bad input must not cost a meshing run.
-  std::vector<meccano::TriangleSurface> surfaces = read_surfaces(options, progress);
-  meccano::validate_surfaces(surfaces, options.box);
-  if (!surfaces.empty()) progress.say("surfaces valid: open disks, inside the box, disjoint");
+  return cells;
+}
 
-  meccano::TetMesh mesh = meccano::make_cube_meccano(options.box, cells, options.level);
-  progress.say("meccano: ", mesh.num_tets(), " tets, ", mesh.num_vertices(), " nodes");
-
+// The method's options as the command line set them; no progress callback.
+meccano::InsertionOptions insertion_options(const Options& options) {
   meccano::InsertionOptions insertion;
   insertion.resolution = options.resolution.value_or(0.0);
   insertion.last_stage = options.stage.value_or(meccano::Stage::smoothing);
@@ -424,6 +446,26 @@ int run(const Options& options) {
   insertion.improvement.threshold = options.improve_threshold;
   insertion.max_tets = options.max_tets;
   insertion.finer_retries = options.finer_retries;
+  return insertion;
+}
+
+int run(const Options& options) {
+  // Every file the run writes, checked before any work: a mistyped path must not cost a meshing run.
+  for (const auto& output : options.outputs) meccano::require_writable(output.path);
+  for (const auto& path : {options.histograms, options.report})
+    if (path) meccano::require_writable(*path);
+  const Progress progress(options.quiet);
+  if (options.threads) omp_set_num_threads(*options.threads);
+  const auto cells = meccano_cells(options, progress);
+  // Read and validate every surface before any meshing: bad input must not cost a meshing run.
+  std::vector<meccano::TriangleSurface> surfaces = read_surfaces(options.surfaces, options, progress);
+  meccano::validate_surfaces(surfaces, options.box);
+  if (!surfaces.empty()) progress.say("surfaces valid: open disks, inside the box, disjoint");
+
+  meccano::TetMesh mesh = meccano::make_cube_meccano(options.box, cells, options.level);
+  progress.say("meccano: ", mesh.num_tets(), " tets, ", mesh.num_vertices(), " nodes");
+
+  meccano::InsertionOptions insertion = insertion_options(options);
   // Without a callback the stages build no progress lines at all.
   if (!options.quiet) insertion.progress = [&progress](const std::string& line) { progress.say(line); };
   const meccano::InsertionResult result = meccano::insert_surfaces(mesh, surfaces, insertion);
@@ -456,6 +498,166 @@ int run(const Options& options) {
   for (const auto& output : options.outputs)
     progress.say("wrote ", output.path, ": ", result.mesh.num_tets(), " tets, ", result.mesh.num_vertices(), " nodes");
   if (options.histograms) progress.say("wrote ", *options.histograms);
+  if (options.report) progress.say("wrote ", *options.report);
+  return 0;
+}
+
+// meccano-immerse sequence: the one-shot command's options that apply, and the surfaces of each step.
+struct SequenceOptions {
+  Options common;  // the outputs are patterns holding {step}
+  meccano::SequenceOptions sequence;
+  std::vector<std::vector<std::pair<std::string, std::string>>> steps;  // per step: (file, name) per surface
+};
+
+// FILE[:NAME],FILE[:NAME],...: the surfaces of one --step.
+std::vector<std::pair<std::string, std::string>> parse_step_argument(const std::string& text) {
+  std::vector<std::pair<std::string, std::string>> surfaces;
+  std::size_t begin = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', begin);
+    const std::string item = text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+    if (item.empty()) throw UsageError("--step " + text + ": an empty surface between commas");
+    surfaces.push_back(meccano::tools::parse_surface_argument(item, surfaces.size() + 1));
+    if (comma == std::string::npos) return surfaces;
+    begin = comma + 1;
+  }
+}
+
+void check_sequence_options(const SequenceOptions& parsed) {
+  const Options& options = parsed.common;
+  if (parsed.steps.empty()) throw UsageError("sequence needs at least one --step");
+  if (!options.resolution) throw UsageError("sequence needs --resolution");
+  if (options.stage || options.histograms)
+    throw UsageError("sequence writes each step's finished mesh: --stage and --histograms are for one insertion");
+  for (const Output& output : options.outputs) {
+    if (output.path.find("{step}") == std::string::npos)
+      throw UsageError("--output " + output.path + ": a sequence's output must hold {step}, replaced by the step");
+    if (meccano::mesh_format_of(output.path) == meccano::MeshFormat::medit)
+      throw UsageError("--output " + output.path +
+                       ": a Medit file holds no node data, and each step carries previous_node: use .msh or .vtu");
+  }
+  const auto names = [](const std::vector<std::pair<std::string, std::string>>& surfaces) {
+    std::string list;
+    for (const auto& surface : surfaces) list += (list.empty() ? "" : ",") + surface.second;
+    return list;
+  };
+  meccano::tools::check_distinct_names(parsed.steps.front());
+  for (std::size_t k = 1; k < parsed.steps.size(); ++k)
+    if (names(parsed.steps[k]) != names(parsed.steps.front()))
+      throw UsageError("--step " + std::to_string(k) + " names the surfaces " + names(parsed.steps[k]) +
+                       ", step 0 names " + names(parsed.steps.front()) +
+                       ": every step names the same surfaces in the same order");
+}
+
+SequenceOptions parse_sequence_options(const std::vector<std::string>& args) {
+  SequenceOptions parsed;
+  Options& options = parsed.common;
+  // Away from the surfaces the mesh then stays the meccano's, node for node, from one step to the next.
+  options.smoothing.mode = meccano::SmoothingMode::band;
+  meccano::MeshWriteOptions output_format;
+  bool msh_version_unused = false;
+  ArgumentParser parser("sequence: ");
+  parser.help(usage_text);
+  declare_mesh_options(parser, options);
+  parser.value({"--step"}, [&](const std::string& text) { parsed.steps.push_back(parse_step_argument(text)); });
+  parser.flag({"--from-scratch"}, [&] { parsed.sequence.always_insert = true; });
+  parser.value({"--max-quality-loss"}, [&](const std::string& text) {
+    parsed.sequence.max_quality_loss = meccano::tools::parse_numbers("--max-quality-loss", text, 1)[0];
+    if (!(parsed.sequence.max_quality_loss >= 0.0)) throw UsageError("--max-quality-loss must not be negative");
+  });
+  parser.value({"--moved-smoothing-sweeps"},
+               store_integer("--moved-smoothing-sweeps", parsed.sequence.smoothing_sweeps_after_moving, 1));
+  declare_method_options(parser, options);
+  declare_output_options(parser, options, output_format, msh_version_unused);
+  parser.parse(args);
+  if (msh_version_unused) throw UsageError("--msh-version applies to the .msh outputs after it, and none follows");
+  check_sequence_options(parsed);
+  return parsed;
+}
+
+// The pattern with every {step} replaced by the step's number.
+std::string step_path(const std::string& pattern, int step) {
+  constexpr std::string_view placeholder = "{step}";
+  std::string path;
+  std::size_t copied = 0;
+  for (auto at = pattern.find(placeholder); at != std::string::npos; at = pattern.find(placeholder, copied)) {
+    path += pattern.substr(copied, at - copied) + std::to_string(step);
+    copied = at + placeholder.size();
+  }
+  return path + pattern.substr(copied);
+}
+
+// meccano-immerse sequence ...: 0 once every step is written.
+int run_sequence(const std::vector<std::string>& args) {
+  const SequenceOptions parsed = parse_sequence_options(args);
+  const Options& options = parsed.common;
+  const int steps = static_cast<int>(parsed.steps.size());
+  for (int k = 0; k < steps; ++k)
+    for (const Output& output : options.outputs) meccano::require_writable(step_path(output.path, k));
+  if (options.report) meccano::require_writable(*options.report);
+  const Progress progress(options.quiet);
+  if (options.threads) omp_set_num_threads(*options.threads);
+  const auto cells = meccano_cells(options, progress);
+  // Every step read and validated before any meshing: bad input must not cost a meshing run.
+  std::vector<std::vector<meccano::TriangleSurface>> surfaces;
+  for (int k = 0; k < steps; ++k) {
+    try {
+      surfaces.push_back(read_surfaces(parsed.steps[k], options, Progress(true)));
+      meccano::validate_surfaces(surfaces.back(), options.box);
+    } catch (const meccano::InputError& error) {
+      throw meccano::InputError("step " + std::to_string(k) + ": " + error.what());
+    }
+  }
+  progress.say("steps: ", steps, ", each of ", surfaces.front().size(),
+               surfaces.front().size() == 1 ? " surface" : " surfaces", ", all valid");
+
+  meccano::TetMesh mesh = meccano::make_cube_meccano(options.box, cells, options.level);
+  progress.say("meccano: ", mesh.num_tets(), " tets, ", mesh.num_vertices(), " nodes");
+  meccano::SurfaceSequence sequence(std::move(mesh), insertion_options(options), parsed.sequence);
+  meccano::StagedFiles files;
+  meccano::JsonWriter report;
+  report.begin_object().key("steps").begin_array();
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < steps; ++k) {
+    const meccano::SequenceStep* step = nullptr;
+    try {
+      step = &sequence.advance(std::move(surfaces[k]));
+    } catch (const meccano::MeshingError& error) {
+      throw meccano::MeshingError("step " + std::to_string(k) + ": " + error.what());
+    }
+    const meccano::InsertionResult& result = step->result;
+    const auto check = meccano::verify_mesh(result.mesh);
+    if (!check.ok())
+      throw meccano::MeshingError("step " + std::to_string(k) +
+                                  ": the mesh fails its invariant checks: " + check.summary());
+    const meccano::NodeField previous_node{
+        "previous_node", {step->previous_node.begin(), step->previous_node.end()}, true};
+    const auto groups = meccano::output_groups(result);
+    for (const Output& output : options.outputs)
+      files.write(step_path(output.path, k), [&](const std::string& path) {
+        meccano::write_mesh(result.mesh, groups, path, output.format, {&previous_node, 1});
+      });
+    meccano::write_sequence_step(report, *step);
+    const meccano::QualitySummary& quality = result.quality_after_smoothing;
+    progress.say("step ", k, ": ", step->kind == meccano::StepKind::moved ? "moved" : "inserted",
+                 step->inserted_because.empty() ? "" : " (" + step->inserted_because + ")", "; ",
+                 result.mesh.num_tets(), " tets, ", result.mesh.num_vertices(), " nodes, ", step->nodes_unchanged,
+                 " unchanged (", 100.0 * static_cast<double>(step->nodes_unchanged) / result.mesh.num_vertices(),
+                 " %); quality min ", quality.meccano.min, " meccano, ", quality.equilateral.min, " equilateral; ",
+                 step->seconds, " s");
+  }
+  report.end_array();
+  report.key("seconds").value(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  report.end_object();
+  if (options.report) {
+    const std::string json = report.str();
+    files.write(*options.report, [&](const std::string& path) {
+      meccano::write_file_atomically(path, [&json](std::ostream& out) { out << json; });
+    });
+  }
+  files.commit();
+  for (const Output& output : options.outputs)
+    progress.say("wrote ", step_path(output.path, 0), " ... ", step_path(output.path, steps - 1));
   if (options.report) progress.say("wrote ", *options.report);
   return 0;
 }
@@ -527,6 +729,7 @@ int main(int argc, char** argv) {
   return meccano::tools::run_reporting_errors("meccano-immerse", [&] {
     if (argc > 1 && std::string(argv[1]) == "check") return run_check({argv + 2, argv + argc});
     if (argc > 1 && std::string(argv[1]) == "measure") return run_measure({argv + 2, argv + argc});
+    if (argc > 1 && std::string(argv[1]) == "sequence") return run_sequence({argv + 2, argv + argc});
     return run(parse_options(argc, argv));
   });
 }

@@ -106,10 +106,9 @@ void write_improvement(JsonWriter& json, const ImprovementStats& s, double secon
 
 }  // namespace
 
-std::string insertion_report_json(const InsertionResult& result, Stage last_stage) {
+void write_insertion_report(JsonWriter& json, const InsertionResult& result, Stage last_stage) {
   const bool smoothed = last_stage == Stage::smoothing && !result.surfaces.empty();
   const bool projected = last_stage >= Stage::projection && !result.surfaces.empty();
-  JsonWriter json;
   json.begin_object();
   json.key("tets").value(result.mesh.num_tets()).key("nodes").value(result.mesh.num_vertices());
   json.key("estimated_tets").value(result.estimated_tets);
@@ -150,7 +149,26 @@ std::string insertion_report_json(const InsertionResult& result, Stage last_stag
   if (smoothed) write_smoothing(json, result.smoothing, result.smoothing_seconds);
   if (smoothed && result.improvement) write_improvement(json, *result.improvement, result.improvement_seconds);
   json.end_object();
+}
+
+std::string insertion_report_json(const InsertionResult& result, Stage last_stage) {
+  JsonWriter json;
+  write_insertion_report(json, result, last_stage);
   return json.str();
+}
+
+void write_sequence_step(JsonWriter& json, const SequenceStep& step) {
+  const InsertionResult& result = step.result;
+  json.begin_object().key("step").value(step.index);
+  json.key("mode").value(step.kind == StepKind::moved ? "moved" : "inserted");
+  if (!step.inserted_because.empty()) json.key("inserted_because").value(step.inserted_because);
+  json.key("seconds").value(step.seconds);
+  json.key("tets").value(result.mesh.num_tets()).key("nodes").value(result.mesh.num_vertices());
+  json.key("nodes_unchanged").value(step.nodes_unchanged);
+  write_quality(json, "quality", result.quality_after_smoothing);
+  json.key("insertion");
+  write_insertion_report(json, result, Stage::smoothing);
+  json.end_object();
 }
 
 }  // namespace meccano

@@ -80,7 +80,8 @@ TEST(MoveSurfaces, MovesTheInterfaceOntoTheMovedSurfaceAndLeavesTheRestAsItWas) 
   const InsertionOptions options = band_options();
   const std::vector<TriangleSurface> before{patch_at(0)}, after{patch_at(1)};
   const InsertionResult inserted = insert_surfaces(meccano, before, options);
-  const InsertionResult moved = move_surfaces(inserted, after, options);
+  const MoveOptions move{.drag_rings = 2};  // few rings, so that the small mesh has nodes beyond the band
+  const InsertionResult moved = move_surfaces(inserted, after, options, move);
 
   EXPECT_TRUE(verify_mesh(moved.mesh).ok()) << verify_mesh(moved.mesh).summary();
   EXPECT_EQ(count_inverted(moved.mesh), 0);
@@ -91,8 +92,8 @@ TEST(MoveSurfaces, MovesTheInterfaceOntoTheMovedSurfaceAndLeavesTheRestAsItWas) 
   ASSERT_EQ(interfaces.size(), 1u);
   EXPECT_EQ(interfaces.front().faces.size(), moved.surfaces.front().projection.triangles.size());
 
-  // Only the S_M nodes and the nodes within SUS's band around them may move; the others keep the previous
-  // step's position exactly.
+  // Only the S_M nodes and the nodes within the band around them (the dragged rings and one more) may
+  // move; the others keep the previous step's position exactly.
   const std::vector<VertexId> previous = match_previous_nodes(inserted.mesh, moved.mesh);
   const std::vector<VertexId>& interface_nodes = moved.surfaces.front().projection.nodes;
   for (const VertexId v : interface_nodes) EXPECT_EQ(previous[v], no_previous_node);
@@ -100,7 +101,8 @@ TEST(MoveSurfaces, MovesTheInterfaceOntoTheMovedSurfaceAndLeavesTheRestAsItWas) 
   std::vector<VertexId> ring = interface_nodes;
   for (const VertexId v : ring) in_band[v] = 1;
   const VertexTets stars = vertex_to_tets(moved.mesh);
-  for (int k = 0; k < options.smoothing.band_rings; ++k) {
+  const int band_rings = std::max(options.smoothing.band_rings, move.drag_rings + 1);
+  for (int k = 0; k < band_rings; ++k) {
     std::vector<VertexId> next;
     for (const VertexId v : ring)
       for (const TetId t : stars.of(v))

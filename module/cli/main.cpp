@@ -565,8 +565,6 @@ SequenceOptions parse_sequence_options(const std::vector<std::string>& args) {
     parsed.sequence.max_quality_loss = meccano::tools::parse_numbers("--max-quality-loss", text, 1)[0];
     if (!(parsed.sequence.max_quality_loss >= 0.0)) throw UsageError("--max-quality-loss must not be negative");
   });
-  parser.value({"--moved-smoothing-sweeps"},
-               store_integer("--moved-smoothing-sweeps", parsed.sequence.smoothing_sweeps_after_moving, 1));
   declare_method_options(parser, options);
   declare_output_options(parser, options, output_format, msh_version_unused);
   parser.parse(args);

@@ -772,7 +772,7 @@ void drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector
 }  // namespace
 
 InsertionResult move_surfaces(const InsertionResult& previous, std::span<const TriangleSurface> surfaces,
-                              const InsertionOptions& options) {
+                              const InsertionOptions& options, const MoveOptions& move) {
   const auto start = std::chrono::steady_clock::now();
   if (surfaces.size() != previous.surfaces.size())
     throw InputError(std::to_string(surfaces.size()) + " surfaces to move, but the previous step inserted " +
@@ -814,8 +814,7 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
     }
     moved.projection_seconds = seconds_since(moving);
   }
-  if (options.smoothing.mode == SmoothingMode::band)
-    drag_neighbours(result.mesh, std::move(moved_node), std::move(displacement), options.smoothing.band_rings - 1);
+  drag_neighbours(result.mesh, std::move(moved_node), std::move(displacement), move.drag_rings);
   const std::int64_t inverted = count_inverted(result.mesh);
   for (SurfaceInsertion& moved : result.surfaces) {
     moved.projection.stats.inverted_tets = inverted;
@@ -823,7 +822,13 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
            moved.projection.stats.largest_move, "; ", inverted, " tets inverted");
   }
   result.quality_before_smoothing = summarize_quality(result.mesh);
-  if (!untangle_smooth_and_improve(result, options))
+  // In a band, the improvement (and SUS, if it runs) reaches every node that followed the interface.
+  InsertionOptions after_move = options;
+  if (after_move.smoothing.mode == SmoothingMode::band)
+    after_move.smoothing.band_rings = std::max(options.smoothing.band_rings, move.drag_rings + 1);
+  if (inverted == 0 && !move.smooth) after_move.smoothing.max_sweeps = 0;  // nothing for SUS to untangle
+  after_move.smoothing.smoothing_sweeps = move.smoothing_sweeps;
+  if (!untangle_smooth_and_improve(result, after_move))
     throw MeshingError("the moved interface leaves " + tets_still_inverted(result));
   result.seconds = seconds_since(start);
   return result;

@@ -40,16 +40,20 @@ std::optional<InsertionResult> SurfaceSequence::try_moving(const std::vector<Tri
                                                            std::string& why) const {
   why = why_not_moved(surfaces);
   if (!why.empty()) return std::nullopt;
-  try {
-    InsertionOptions moving = options_;
-    moving.smoothing.smoothing_sweeps = sequence_.smoothing_sweeps_after_moving;
-    InsertionResult moved = move_surfaces(last_->result, surfaces, moving);
-    why = quality_loss(moved.quality_after_smoothing, inserted_quality_, sequence_.max_quality_loss);
-    if (why.empty()) return moved;
-    why = "moving lost quality: " + why;
-  } catch (const MeshingError& error) {
-    why = std::string("moving failed: ") + error.what();
+  std::string failures;
+  for (const MoveOptions& move : sequence_.moves) {
+    std::string failure;
+    try {
+      InsertionResult moved = move_surfaces(last_->result, surfaces, options_, move);
+      failure = quality_loss(moved.quality_after_smoothing, inserted_quality_, sequence_.max_quality_loss);
+      if (failure.empty()) return moved;
+      failure = "lost quality: " + failure;
+    } catch (const MeshingError& error) {
+      failure = std::string("failed: ") + error.what();
+    }
+    failures += (failures.empty() ? "moving " : "; moving again ") + failure;
   }
+  why = failures;
   return std::nullopt;
 }
 

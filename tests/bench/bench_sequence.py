@@ -1,0 +1,190 @@
+#!/usr/bin/env python3
+"""A moving interface, step by step (issue 20; doc/comparison.md, "d) A moving surface").
+
+usage: bench_sequence.py [--quick] [--build DIR] [--work DIR] [--hxt-every K]
+
+Cases (each 21 positions, step 0 as given; --quick: 6):
+  patch_translate  the cube example's surface (compare_references.py moved 0 48) raised by l_r / 4 per
+                   step, in the unit cube at level 12, l_r = 1/64 (the setting of comparison.md d);
+  fault_translate  East Huasna (shared/data/faults) moved by l_r / 4 per step along its mean normal,
+                   l_r = E / 50, E the largest extent of its bounding box;
+  fault_rotate     the same fault turned by 1 degree per step about the vertical axis through its
+                   centroid (its far ends move by about 0.4 l_r per step).
+The faults' box holds every position: the bounding box of all of them grown by E / 10 on every side.
+
+Each case runs `meccano-immerse sequence` twice, one after the other: as it is (moving the interface
+while it can) and with --from-scratch (every step inserted anew into the meccano mesh), both with SUS
+in a band (sequence's default) and 2 threads. Every --hxt-every K-th step (default 10) is also meshed
+by Gmsh HXT from scratch at equal interface resolution (reference-gmsh with the size field of
+bench_faults.sh: the surface split to about the module's interface edge h_S, size h_S near it growing
+to the far size at 4 l_r). Prints one Markdown table per case and a summary; seconds are single runs on
+a machine that may be shared: compare the columns of one row.
+"""
+import json
+import math
+import os
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from bench_faults import bounding_box, far_size, read_surface, write_subdivided  # noqa: E402
+from compare_references import interface_edge, moved_patch  # noqa: E402
+
+FAULT = os.path.join(HERE, "..", "..", "..", "shared", "data", "faults",
+                     "CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts")
+
+
+def write_obj(path, points, triangles):
+    with open(path, "w") as f:
+        for p in points:
+            f.write("v {!r} {!r} {!r}\n".format(*p))
+        for t in triangles:
+            f.write("f {} {} {}\n".format(*(v + 1 for v in t)))
+
+
+def mean_normal(points, triangles):
+    total = [0.0, 0.0, 0.0]
+    for a, b, c in triangles:
+        u = [points[b][k] - points[a][k] for k in range(3)]
+        v = [points[c][k] - points[a][k] for k in range(3)]
+        n = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+        total = [total[k] + n[k] for k in range(3)]
+    length = math.sqrt(sum(x * x for x in total))
+    return [x / length for x in total]
+
+
+def patch_steps(count):
+    points, triangles = moved_patch(0, 48)
+    resolution = 1 / 64
+    positions = [[(x, y, z + k * resolution / 4) for x, y, z in points] for k in range(count)]
+    return positions, triangles, "0,0,0,1,1,1", resolution, ["--level", "12"]
+
+
+def fault_steps(count, motion):
+    points, triangles = read_surface(FAULT)
+    low, high = bounding_box(points)
+    extent = max(high[k] - low[k] for k in range(3))
+    resolution = extent / 50
+    if motion == "translate":
+        normal = mean_normal(points, triangles)
+        positions = [[tuple(p[j] + k * resolution / 4 * normal[j] for j in range(3)) for p in points]
+                     for k in range(count)]
+    else:
+        centre = [sum(p[j] for p in points) / len(points) for j in range(3)]
+        positions = []
+        for k in range(count):
+            c, s = math.cos(math.radians(k)), math.sin(math.radians(k))
+            positions.append([(centre[0] + c * (x - centre[0]) - s * (y - centre[1]),
+                               centre[1] + s * (x - centre[0]) + c * (y - centre[1]), z) for x, y, z in points])
+    low, high = bounding_box([p for position in positions for p in position])
+    box = [low[k] - extent / 10 for k in range(3)] + [high[k] + extent / 10 for k in range(3)]
+    return positions, triangles, ",".join(repr(v) for v in box), resolution, []
+
+
+def run_sequence(cli, files, box, resolution, extra, work, name, scratch):
+    report = os.path.join(work, f"{name}.json")
+    command = [cli, "sequence", "--box", box, "--resolution", repr(resolution), "--threads", "2", "--quiet",
+               "--output", os.path.join(work, f"{name}_{{step}}.msh"), "--report", report] + extra
+    for f in files:
+        command += ["--step", f + ":surface"]
+    if scratch:
+        command.append("--from-scratch")
+    subprocess.run(command, check=True)
+    with open(report) as f:
+        return json.load(f)["steps"]
+
+
+def run_hxt(build, cli, surface, box, resolution, mesh, work, name):
+    """Gmsh HXT from scratch at the interface resolution of the module's mesh `mesh`."""
+    measure = os.path.join(work, f"{name}.measure.json")
+    subprocess.run([cli, "measure", mesh, "--surface", surface + ":surface", "--quiet", "--report", measure],
+                   check=True)
+    with open(measure) as f:
+        h_s = interface_edge(json.load(f))
+    split = subprocess.run([sys.executable, os.path.join(HERE, "bench_faults.py"), "subdivide", surface,
+                            repr(math.sqrt(2) * h_s), work], check=True, capture_output=True, text=True)
+    split_surface = split.stdout.split()[0]
+    numbers = [float(v) for v in box.split(",")]
+    report = os.path.join(work, f"{name}.hxt.json")
+    subprocess.run([os.path.join(build, "reference", "reference-gmsh"), "--box", box, "--algorithm", "hxt",
+                    "--threads", "2", "--surface", split_surface + ":surface", "--size", repr(far_size(numbers)),
+                    "--size-near-surface", repr(h_s), "--size-distance", repr(4 * resolution), "--quiet",
+                    "--output", os.path.join(work, f"{name}.hxt.msh"), "--report", report], check=True)
+    with open(report) as f:
+        return json.load(f)
+
+
+def percent(part, whole):
+    return f"{100 * part / whole:.1f} %"
+
+
+def case_table(name, moving, scratch, hxt):
+    print(f"\n### {name}\n")
+    print("| step | mode | seconds moving / anew | speed-up | tets moving / anew | nodes unchanged moving / anew "
+          "| η meccano min moving / anew | η equilateral min moving / anew | min dihedral moving / anew "
+          "| HXT s (tets) | HXT s ÷ moving s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for m, s in zip(moving, scratch):
+        h = hxt.get(m["step"])
+        hxt_cells = (f"{h['seconds']['total']:.2f} ({h['tets']:,})", f"{h['seconds']['total'] / m['seconds']:.1f}") \
+            if h else ("", "")
+        print(f"| {m['step']} | {m['mode']} | {m['seconds']:.2f} / {s['seconds']:.2f} | "
+              f"{s['seconds'] / m['seconds']:.1f}× | {m['tets']:,} / {s['tets']:,} | "
+              f"{percent(m['nodes_unchanged'], m['nodes'])} / {percent(s['nodes_unchanged'], s['nodes'])} | "
+              f"{m['quality']['meccano']['min']:.3f} / {s['quality']['meccano']['min']:.3f} | "
+              f"{m['quality']['equilateral']['min']:.3f} / {s['quality']['equilateral']['min']:.3f} | "
+              f"{m['quality']['min_dihedral_deg']:.1f}° / {s['quality']['min_dihedral_deg']:.1f}° | "
+              f"{hxt_cells[0]} | {hxt_cells[1]} |")
+
+
+def summary_row(name, moving, scratch, hxt):
+    later = list(zip(moving[1:], scratch[1:]))
+    moved = [(m, s) for m, s in later if m["mode"] == "moved"]
+    speedups = sorted(s["seconds"] / m["seconds"] for m, s in moved)
+    median = speedups[len(speedups) // 2] if speedups else float("nan")
+    total = sum(s["seconds"] for _, s in later) / sum(m["seconds"] for m, _ in later)
+    loss = max(max(s["quality"][k]["min"] - m["quality"][k]["min"] for k in ("meccano", "equilateral"))
+               for m, s in later)
+    unchanged = min(m["nodes_unchanged"] / m["nodes"] for m, _ in moved) if moved else float("nan")
+    hxt_ratio = [hxt[m["step"]]["seconds"]["total"] / m["seconds"] for m in moving[1:]
+                 if m["step"] in hxt and m["mode"] == "moved"]
+    print(f"| {name} | {len(moved)} of {len(later)} | {median:.1f}× | {total:.1f}× | "
+          f"{', '.join(f'{r:.1f}×' for r in hxt_ratio) or '–'} | {100 * unchanged:.1f} % | "
+          f"{moving[-1]['tets'] / scratch[-1]['tets']:.3f} | {loss:+.3f} |")
+
+
+def main(argv):
+    quick = "--quick" in argv
+    build = argv[argv.index("--build") + 1] if "--build" in argv else os.path.join(HERE, "..", "..", "build")
+    work = argv[argv.index("--work") + 1] if "--work" in argv else "/tmp/bench-sequence"
+    hxt_every = int(argv[argv.index("--hxt-every") + 1]) if "--hxt-every" in argv else 10
+    cli = os.path.join(build, "module", "meccano-immerse")
+    os.makedirs(work, exist_ok=True)
+    count = 6 if quick else 21
+    cases = {"patch_translate": patch_steps(count), "fault_translate": fault_steps(count, "translate"),
+             "fault_rotate": fault_steps(count, "rotate")}
+    results = {}
+    for name, (positions, triangles, box, resolution, extra) in cases.items():
+        files = []
+        for k, points in enumerate(positions):
+            files.append(os.path.join(work, f"{name}_surface_{k}.obj"))
+            write_obj(files[-1], points, triangles)
+        moving = run_sequence(cli, files, box, resolution, extra, work, f"{name}_moving", False)
+        scratch = run_sequence(cli, files, box, resolution, extra, work, f"{name}_anew", True)
+        hxt = {k: run_hxt(build, cli, files[k], box, resolution, os.path.join(work, f"{name}_moving_{k}.msh"), work,
+                          f"{name}_{k}")
+               for k in range(0, count, hxt_every)} if hxt_every > 0 else {}
+        results[name] = (moving, scratch, hxt)
+        case_table(name, moving, scratch, hxt)
+    print("\n### Summary\n")
+    print("| case | steps moved | median speed-up of a moved step | speed-up of steps 1.. in all | HXT s ÷ module s "
+          "(moved steps measured) | nodes unchanged, least of moved steps | tets at the last step ÷ anew "
+          "| largest η min loss against anew |")
+    print("|---|---|---|---|---|---|---|---|")
+    for name, (moving, scratch, hxt) in results.items():
+        summary_row(name, moving, scratch, hxt)
+
+
+if __name__ == "__main__":
+    main(sys.argv)

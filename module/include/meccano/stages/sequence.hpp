@@ -5,12 +5,12 @@
 //          the same order every step, each valid on its own (validate_surfaces).
 // Steps    The first step inserts the surfaces (insert_surfaces). A later step whose surfaces keep their
 //          triangulations (only points moved) moves the previous step's interface onto them
-//          (move_surfaces), in up to two ways: first six rings of nodes follow the interface and the
-//          improvement alone restores the mesh around it (0.13-0.2 s where an insertion of the East
-//          Huasna fault at E/50 takes 1.1-2 s); if tets stay inverted or the quality does not hold, two
-//          rings follow and SUS (two smoothing sweeps) smooths the band before the improvement. SUS keeps
-//          the paper's measure better on smooth surfaces, but from a valid start on meshes with tiny tets
-//          (crease splits) it can tangle them and then costs as much as an insertion, hence second.
+//          (move_surfaces), trying SequenceOptions::moves in turn: first six rings of nodes follow the
+//          interface and the improvement alone restores the mesh around it (a tenth of an insertion's
+//          cost on a fault, design.md "A moving interface"); if tets stay inverted or the quality does not
+//          hold, two rings follow and SUS smooths the band before the improvement. SUS keeps the paper's
+//          measure better on smooth surfaces, but from a valid start on meshes with tiny tets (crease
+//          splits) it can tangle them and then costs as much as an insertion, hence second.
 //          Away from the interface the mesh stays the previous step's, node for node. The step inserts
 //          the surfaces anew instead, from the meccano mesh, when
 //            - a triangulation changed,

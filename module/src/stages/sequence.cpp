@@ -24,7 +24,7 @@ std::string quality_loss(const QualitySummary& moved, const QualitySummary& inse
 }  // namespace
 
 SurfaceSequence::SurfaceSequence(TetMesh meccano, InsertionOptions options, SequenceOptions sequence)
-    : meccano_(std::move(meccano)), options_(std::move(options)), sequence_(sequence) {}
+    : meccano_(std::move(meccano)), options_(std::move(options)), sequence_(std::move(sequence)) {}
 
 std::string SurfaceSequence::why_not_moved(const std::vector<TriangleSurface>& surfaces) const {
   if (surfaces.size() != surfaces_.size()) return "the number of surfaces changed";

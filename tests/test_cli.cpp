@@ -428,6 +428,10 @@ TEST_F(CliTest, SequenceRefusesWhatItCannotDoAndWritesNothing) {
        "every step names the same surfaces in the same order"},
       {start + "--step " + patch + ", --output " + path("a_{step}.msh"), "an empty surface between commas"},
       {start + "--step " + patch + " --stage volumetric --output " + path("a_{step}.msh"), "--stage and --histograms"},
+      {start + "--step " + patch + " --max-move -0.5 --output " + path("a_{step}.msh"),
+       "--max-move must not be negative"},
+      {start + "--step " + patch + " --max-quality-loss x --output " + path("a_{step}.msh"),
+       "--max-quality-loss: 'x' is not a finite number"},
   };
   for (const auto& [arguments, message] : usage) {
     const CliRun run = run_cli(arguments);

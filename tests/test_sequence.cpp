@@ -183,6 +183,15 @@ TEST(SurfaceSequence, InsertsAnewWhenAskedOrWhenTheTriangulationChanges) {
   EXPECT_EQ(step.kind, StepKind::inserted);
   EXPECT_NE(step.inserted_because.find("triangulation"), std::string::npos) << step.inserted_because;
   EXPECT_TRUE(verify_mesh(step.result.mesh).ok());
+
+  // Two l_r in one step: beyond max_move_in_resolutions (1), so no move is tried.
+  const TriangleSurface jumped = translated(finer, {0.0, 0.0, 2 * resolution});
+  const SequenceStep& jump = sequence.advance({jumped});
+  EXPECT_EQ(jump.kind, StepKind::inserted);
+  EXPECT_NE(jump.inserted_because.find("patch moved by 2 l_r, more than 1"), std::string::npos)
+      << jump.inserted_because;
+  EXPECT_TRUE(verify_mesh(jump.result.mesh).ok());
+  EXPECT_LT(largest_node_distance(jump.result, jumped), 1e-12);
 }
 
 }  // namespace

@@ -163,6 +163,14 @@ inline std::vector<double> parse_numbers(const std::string& option, const std::s
   return values;
 }
 
+// One finite number of at least 0 (a single number goes through the comma-separated reader, as it always
+// did: "1," reads as 1).
+inline double parse_non_negative(const std::string& option, const std::string& text) {
+  const double value = parse_numbers(option, text, 1)[0];
+  if (value < 0) throw UsageError(option + " must not be negative");
+  return value;
+}
+
 // An integer of type Int that is the whole text, in std::stoll's syntax (leading spaces and '+' allowed).
 template <class Int = int>
 Int parse_integer(const std::string& option, const std::string& text) {

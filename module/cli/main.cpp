@@ -145,8 +145,12 @@ node for node the same. The options of the one-shot command apply, but for --sur
 together once every step is done. Progress: one line per step. --report FILE.json writes one object per
 step under `steps` (step, seconds, tets, nodes, nodes_unchanged, quality with meccano and equilateral
 min/mean/std, inverted, min_dihedral_deg, max_dihedral_deg, and the step's whole report under
-`insertion`) and the total `seconds`. Each step is inserted into the meccano mesh anew; the incremental
-update that reuses the previous step's mesh is not implemented yet.
+`insertion`) and the total `seconds`. A step whose surfaces keep their triangulations is made from the
+previous step's mesh: its interface moves onto them and the rings of nodes around it follow (mode
+"moved"); it is inserted into the meccano mesh anew (mode "inserted", with `inserted_because`) when a
+triangulation changed, when a vertex moved farther than --max-move l_r (default 1), or when the moved
+mesh stays tangled or its worst tet falls more than --max-quality-loss (default 0.02, either mean ratio)
+below what the insertions gave. --from-scratch inserts every step anew.
 
 check FILE.msh checks the invariants of a tet mesh of a box in any Gmsh MSH file (2.2 or 4.1, ASCII or
 binary; this tool's, Gmsh's, ...): conformity, orientation, volume, the box sides xmin ... zmax (if the
@@ -248,11 +252,8 @@ void declare_mesh_options(ArgumentParser& parser, Options& options) {
     options.level = meccano::tools::parse_integer("--level", text);
     if (options.level < 0 || options.level > 40) throw UsageError("--level must be between 0 and 40");
   });
-  // Single numbers go through the comma-separated reader, as they always did: "1," reads as 1.
   parser.value({"--weld-tolerance"}, [&](const std::string& text) {
-    const double tolerance = meccano::tools::parse_numbers("--weld-tolerance", text, 1)[0];
-    if (tolerance < 0) throw UsageError("--weld-tolerance must not be negative");
-    options.reading.weld_tolerance = tolerance;
+    options.reading.weld_tolerance = meccano::tools::parse_non_negative("--weld-tolerance", text);
   });
   parser.value({"--resolution"}, [&](const std::string& text) {
     const double l = meccano::tools::parse_numbers("--resolution", text, 1)[0];
@@ -562,8 +563,10 @@ SequenceOptions parse_sequence_options(const std::vector<std::string>& args) {
   parser.value({"--step"}, [&](const std::string& text) { parsed.steps.push_back(parse_step_argument(text)); });
   parser.flag({"--from-scratch"}, [&] { parsed.sequence.always_insert = true; });
   parser.value({"--max-quality-loss"}, [&](const std::string& text) {
-    parsed.sequence.max_quality_loss = meccano::tools::parse_numbers("--max-quality-loss", text, 1)[0];
-    if (!(parsed.sequence.max_quality_loss >= 0.0)) throw UsageError("--max-quality-loss must not be negative");
+    parsed.sequence.max_quality_loss = meccano::tools::parse_non_negative("--max-quality-loss", text);
+  });
+  parser.value({"--max-move"}, [&](const std::string& text) {
+    parsed.sequence.max_move_in_resolutions = meccano::tools::parse_non_negative("--max-move", text);
   });
   declare_method_options(parser, options);
   declare_output_options(parser, options, output_format, msh_version_unused);

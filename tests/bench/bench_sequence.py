@@ -4,6 +4,9 @@
 usage: bench_sequence.py [--quick] [--build DIR] [--work DIR] [--hxt-every K]
 
 Cases (each 21 positions, step 0 as given; --quick: 6):
+  patch_tilt       the 6 steps of comparison.md d (compare_references.py moved_patch): the cube example's
+                   surface tilted by 1 degree and raised by 0.02 (1.3 l_r) per step, unit cube, level 12,
+                   l_r = 1/64; always 6 positions, a motion beyond the issue's l_r / 2;
   patch_translate  the cube example's surface (compare_references.py moved 0 48) raised by l_r / 4 per
                    step, in the unit cube at level 12, l_r = 1/64 (the setting of comparison.md d);
   fault_translate  East Huasna (shared/data/faults) moved by l_r / 4 per step along its mean normal,
@@ -14,7 +17,7 @@ The faults' box holds every position: the bounding box of all of them grown by E
 
 Each case runs `meccano-immerse sequence` twice, one after the other: as it is (moving the interface
 while it can) and with --from-scratch (every step inserted anew into the meccano mesh), both with SUS
-in a band (sequence's default) and 2 threads. Every --hxt-every K-th step (default 10) is also meshed
+in a band (sequence's default) and 2 threads. Every --hxt-every K-th step (default 10) and the last one are also meshed
 by Gmsh HXT from scratch at equal interface resolution (reference-gmsh with the size field of
 bench_faults.sh: the surface split to about the module's interface edge h_S, size h_S near it growing
 to the far size at 4 l_r). Prints one Markdown table per case and a summary; seconds are single runs on
@@ -54,11 +57,14 @@ def mean_normal(points, triangles):
     return [x / length for x in total]
 
 
-def patch_steps(count):
-    points, triangles = moved_patch(0, 48)
+def patch_steps(count, motion):
     resolution = 1 / 64
-    positions = [[(x, y, z + k * resolution / 4) for x, y, z in points] for k in range(count)]
-    return positions, triangles, "0,0,0,1,1,1", resolution, ["--level", "12"]
+    if motion == "tilt":
+        positions = [moved_patch(k, 48)[0] for k in range(count)]
+    else:
+        points = moved_patch(0, 48)[0]
+        positions = [[(x, y, z + k * resolution / 4) for x, y, z in points] for k in range(count)]
+    return positions, moved_patch(0, 48)[1], "0,0,0,1,1,1", resolution, ["--level", "12"]
 
 
 def fault_steps(count, motion):
@@ -162,8 +168,8 @@ def main(argv):
     cli = os.path.join(build, "module", "meccano-immerse")
     os.makedirs(work, exist_ok=True)
     count = 6 if quick else 21
-    cases = {"patch_translate": patch_steps(count), "fault_translate": fault_steps(count, "translate"),
-             "fault_rotate": fault_steps(count, "rotate")}
+    cases = {"patch_tilt": patch_steps(6, "tilt"), "patch_translate": patch_steps(count, "translate"),
+             "fault_translate": fault_steps(count, "translate"), "fault_rotate": fault_steps(count, "rotate")}
     results = {}
     for name, (positions, triangles, box, resolution, extra) in cases.items():
         files = []
@@ -174,7 +180,7 @@ def main(argv):
         scratch = run_sequence(cli, files, box, resolution, extra, work, f"{name}_anew", True)
         hxt = {k: run_hxt(build, cli, files[k], box, resolution, os.path.join(work, f"{name}_moving_{k}.msh"), work,
                           f"{name}_{k}")
-               for k in range(0, count, hxt_every)} if hxt_every > 0 else {}
+               for k in sorted({*range(0, len(files), hxt_every), len(files) - 1})} if hxt_every > 0 else {}
         results[name] = (moving, scratch, hxt)
         case_table(name, moving, scratch, hxt)
     print("\n### Summary\n")

@@ -32,6 +32,16 @@ std::string SurfaceSequence::why_not_moved(const std::vector<TriangleSurface>& s
     if (surfaces[s].name != surfaces_[s].name) return "surface " + std::to_string(s + 1) + " was renamed";
     if (surfaces[s].points.size() != surfaces_[s].points.size() || surfaces[s].triangles != surfaces_[s].triangles)
       return "the triangulation of " + surfaces[s].name + " changed";
+    double farthest = 0.0;
+    for (std::size_t i = 0; i < surfaces[s].points.size(); ++i)
+      farthest = std::max(farthest, (surfaces[s].points[i] - surfaces_[s].points[i]).norm());
+    const double resolution = last_->result.surfaces[s].resolution;
+    if (farthest > sequence_.max_move_in_resolutions * resolution) {
+      std::ostringstream why;
+      why << surfaces[s].name << " moved by " << farthest / resolution << " l_r, more than "
+          << sequence_.max_move_in_resolutions;
+      return why.str();
+    }
   }
   return {};
 }

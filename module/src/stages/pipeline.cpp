@@ -725,17 +725,26 @@ std::unique_ptr<ParametricSurface> moved_parameterization(const ParametricSurfac
 }
 
 // Every node within `rings` edge rings of a moved node (`moved`, with its `displacement`) but not moved
-// itself follows it: by the mean displacement of its neighbours in the rings before, times
-// 1 - k / (rings + 1) in ring k, along the axes the box leaves it. The tets beside the interface then keep
-// their shape instead of being squeezed or inverted, and SUS has less to do.
+// itself follows it, along the axes the box leaves it: by the mean full displacement of its neighbours
+// in the rings before, times 1 - r / R, r its distance from the moved nodes along the mesh's edges and R
+// the distance of the nearest node of ring rings + 1 (which, like every node beyond R, stays put; if the
+// rings hold the whole mesh, (rings + 1) / rings times the farthest dragged node's distance). The
+// tets beside the interface then keep their shape instead of being squeezed or inverted, and SUS has less
+// to do. The fade goes by distance, not by ring: by ring, the two ends of a tet's edge moved by shares
+// 1/(rings + 1) apart whatever its length, which crushed the metre-long tets of crease splits on faults.
 void drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector<Eigen::Vector3d> displacement,
                      int rings) {
   const VertexTets stars = vertex_to_tets(mesh);
   const GridPoint upper = mesh.meccano.upper_corner();
-  std::vector<VertexId> frontier;
+  std::vector<double> distance(mesh.points.size(), std::numeric_limits<double>::infinity());
+  std::vector<VertexId> frontier, dragged;
   for (VertexId v = 0; v < mesh.num_vertices(); ++v)
-    if (moved[v]) frontier.push_back(v);
-  for (int ring = 1; ring <= rings && !frontier.empty(); ++ring) {
+    if (moved[v]) {
+      frontier.push_back(v);
+      distance[v] = 0.0;
+    }
+  double reach = std::numeric_limits<double>::infinity();  // R
+  for (int ring = 1; ring <= rings + 1 && !frontier.empty(); ++ring) {
     std::vector<VertexId> next;
     for (const VertexId v : frontier)
       for (const TetId t : stars.of(v))
@@ -746,7 +755,6 @@ void drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector
           }
     std::ranges::sort(next);
     next.erase(std::unique(next.begin(), next.end()), next.end());
-    const double share = 1.0 - static_cast<double>(ring) / (rings + 1);
     for (const VertexId w : next) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       int count = 0;
@@ -754,18 +762,27 @@ void drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector
         for (const VertexId u : mesh.tets[t])
           if (moved[u] == 1) {
             sum += displacement[u];
+            distance[w] = std::min(distance[w], distance[u] + (mesh.points[w] - mesh.points[u]).norm());
             ++count;
           }
-      Eigen::Vector3d d = share * sum / count;
-      for (int axis = 0; axis < 3; ++axis)
-        if (mesh.grid[w][axis] == 0 || mesh.grid[w][axis] == upper[axis]) d[axis] = 0.0;
-      displacement[w] = d;
+      displacement[w] = sum / count;
+      if (ring > rings) reach = std::min(reach, distance[w]);
     }
-    for (const VertexId w : next) {
-      moved[w] = 1;
-      mesh.points[w] += displacement[w];
-    }
+    for (const VertexId w : next) moved[w] = 1;
+    if (ring <= rings) dragged.insert(dragged.end(), next.begin(), next.end());
     frontier = std::move(next);
+  }
+  if (reach == std::numeric_limits<double>::infinity() && !dragged.empty()) {  // the rings hold the whole mesh
+    double farthest = 0.0;
+    for (const VertexId w : dragged) farthest = std::max(farthest, distance[w]);
+    reach = farthest * (rings + 1) / rings;
+  }
+  for (const VertexId w : dragged) {
+    if (!(distance[w] < reach)) continue;
+    Eigen::Vector3d d = (1.0 - distance[w] / reach) * displacement[w];
+    for (int axis = 0; axis < 3; ++axis)
+      if (mesh.grid[w][axis] == 0 || mesh.grid[w][axis] == upper[axis]) d[axis] = 0.0;
+    mesh.points[w] += d;
   }
 }
 

@@ -123,7 +123,7 @@ InsertionResult insert_surfaces(const TetMesh& mesh, std::span<const TriangleSur
 
 // How move_surfaces moves an interface.
 struct MoveOptions {
-  int drag_rings = 6;        // rings of nodes around S_M that follow it, by a displacement fading ring by ring
+  int drag_rings = 6;        // rings of nodes around S_M that follow it, by a displacement fading with distance
   bool smooth = false;       // run SUS even when the move leaves no tet inverted (it runs whenever one is)
   int smoothing_sweeps = 2;  // SUS's smoothing sweeps after a move: the rest of the mesh is smooth already
 };
@@ -133,9 +133,9 @@ struct MoveOptions {
 // their points moved.
 //   1. Each S_M node keeps its parameters u in P and goes to φ(u), φ the previous step's parameterization
 //      over the moved surface (the parameters of S's vertices kept, their positions new).
-//   2. The nodes within move.drag_rings edge rings of S_M follow: a node of ring k moves by
-//      1 - k / (drag_rings + 1) times the mean displacement of its neighbours in the rings before, along
-//      the axes the box leaves it. The tets beside the interface keep their shape instead of being
+//   2. The nodes within move.drag_rings edge rings of S_M follow: a node moves by 1 - r / R times the
+//      mean displacement of its neighbours in the rings before, r its distance from S_M along the mesh's
+//      edges and R that of the nearest node of the next ring, along the axes the box leaves it. The tets beside the interface keep their shape instead of being
 //      squeezed or inverted (a quarter of l_r inverted 10 000 of the cube example's 273 000 tets at
 //      l_r = 1/64 without it, none with it).
 //   3. SUS, if the move left tets inverted (or move.smooth), with move.smoothing_sweeps smoothing sweeps;

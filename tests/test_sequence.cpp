@@ -166,7 +166,8 @@ TEST(SurfaceSequence, MovesWhileItCanAndEveryStepIsValid) {
     previous_copy = step.result.mesh;
     previous_mesh = &previous_copy;
   }
-  EXPECT_GE(moved, 4) << "most quarter steps are moved, not inserted anew";
+  // 8 of 8 with the drag fading by distance; 6 when it faded ring by ring and squeezed the small tets.
+  EXPECT_GE(moved, 7) << "quarter steps are moved, not inserted anew";
 }
 
 TEST(SurfaceSequence, InsertsAnewWhenAskedOrWhenTheTriangulationChanges) {

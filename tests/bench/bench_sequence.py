@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""A moving interface, step by step (issue 20; doc/comparison.md, "d) A moving surface").
+"""A moving interface, step by step (issue 20; doc/comparison.md, "A moving surface, step by step").
 
-usage: bench_sequence.py [--quick] [--build DIR] [--work DIR] [--hxt-every K]
+usage: bench_sequence.py [--quick] [--build DIR] [--work DIR] [--hxt-every K] [--fault FILE.ts] [--cases A,B]
 
 Cases (each 21 positions, step 0 as given; --quick: 6):
   patch_tilt       the 6 steps of comparison.md d (compare_references.py moved_patch): the cube example's
@@ -13,6 +13,7 @@ Cases (each 21 positions, step 0 as given; --quick: 6):
                    l_r = E / 50, E the largest extent of its bounding box;
   fault_rotate     the same fault turned by 1 degree per step about the vertical axis through its
                    centroid (its far ends move by about 0.4 l_r per step).
+--fault FILE.ts moves another fault instead of East Huasna; --cases runs only the cases named.
 The faults' box holds every position: the bounding box of all of them grown by E / 10 on every side.
 
 Each case runs `meccano-immerse sequence` twice, one after the other: as it is (moving the interface
@@ -31,10 +32,10 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from bench_faults import bounding_box, far_size, read_surface, write_subdivided  # noqa: E402
+from bench_faults import bounding_box, far_size, read_surface  # noqa: E402
 from compare_references import interface_edge, moved_patch  # noqa: E402
 
-FAULT = os.path.join(HERE, "..", "..", "..", "shared", "data", "faults",
+DEFAULT_FAULT = os.path.join(HERE, "..", "..", "..", "shared", "data", "faults",
                      "CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts")
 
 
@@ -67,8 +68,8 @@ def patch_steps(count, motion):
     return positions, moved_patch(0, 48)[1], "0,0,0,1,1,1", resolution, ["--level", "12"]
 
 
-def fault_steps(count, motion):
-    points, triangles = read_surface(FAULT)
+def fault_steps(fault, count, motion):
+    points, triangles = read_surface(fault)
     low, high = bounding_box(points)
     extent = max(high[k] - low[k] for k in range(3))
     resolution = extent / 50
@@ -168,10 +169,15 @@ def main(argv):
     cli = os.path.join(build, "module", "meccano-immerse")
     os.makedirs(work, exist_ok=True)
     count = 6 if quick else 21
-    cases = {"patch_tilt": patch_steps(6, "tilt"), "patch_translate": patch_steps(count, "translate"),
-             "fault_translate": fault_steps(count, "translate"), "fault_rotate": fault_steps(count, "rotate")}
+    fault = argv[argv.index("--fault") + 1] if "--fault" in argv else DEFAULT_FAULT
+    cases = {"patch_tilt": lambda: patch_steps(6, "tilt"), "patch_translate": lambda: patch_steps(count, "translate"),
+             "fault_translate": lambda: fault_steps(fault, count, "translate"),
+             "fault_rotate": lambda: fault_steps(fault, count, "rotate")}
+    if "--cases" in argv:
+        cases = {name: cases[name] for name in argv[argv.index("--cases") + 1].split(",")}
     results = {}
-    for name, (positions, triangles, box, resolution, extra) in cases.items():
+    for name, make_case in cases.items():
+        positions, triangles, box, resolution, extra = make_case()
         files = []
         for k, points in enumerate(positions):
             files.append(os.path.join(work, f"{name}_surface_{k}.obj"))

@@ -149,15 +149,15 @@ def summary_row(name, moving, scratch, hxt):
     later = list(zip(moving[1:], scratch[1:]))
     moved = [(m, s) for m, s in later if m["mode"] == "moved"]
     speedups = sorted(s["seconds"] / m["seconds"] for m, s in moved)
-    median = speedups[len(speedups) // 2] if speedups else float("nan")
+    median = f"{speedups[len(speedups) // 2]:.1f}×" if speedups else "–"
     total = sum(s["seconds"] for _, s in later) / sum(m["seconds"] for m, _ in later)
     loss = max(max(s["quality"][k]["min"] - m["quality"][k]["min"] for k in ("meccano", "equilateral"))
                for m, s in later)
-    unchanged = min(m["nodes_unchanged"] / m["nodes"] for m, _ in moved) if moved else float("nan")
+    unchanged = f'{100 * min(m["nodes_unchanged"] / m["nodes"] for m, _ in moved):.1f} %' if moved else "–"
     hxt_ratio = [hxt[m["step"]]["seconds"]["total"] / m["seconds"] for m in moving[1:]
                  if m["step"] in hxt and m["mode"] == "moved"]
-    print(f"| {name} | {len(moved)} of {len(later)} | {median:.1f}× | {total:.1f}× | "
-          f"{', '.join(f'{r:.1f}×' for r in hxt_ratio) or '–'} | {100 * unchanged:.1f} % | "
+    print(f"| {name} | {len(moved)} of {len(later)} | {median} | {total:.1f}× | "
+          f"{', '.join(f'{r:.1f}×' for r in hxt_ratio) or '–'} | {unchanged} | "
           f"{moving[-1]['tets'] / scratch[-1]['tets']:.3f} | {loss:+.3f} |")
 
 

@@ -3,6 +3,8 @@
 #include <meccano/error.hpp>
 #include <meccano/geometry/geometry.hpp>
 #include <meccano/stages/parameterization.hpp>
+#include <meccano/surface/rim_chords.hpp>
+#include <meccano/surface/validation.hpp>
 
 #include "test_surfaces.hpp"
 
@@ -597,6 +599,56 @@ TEST(Parameterization, CornersMustBeRimVerticesInCyclicOrder) {
   EXPECT_THROW(parameterize_to_square(plane, {0, 6, 24, 20}), std::invalid_argument);  // 6 is interior
   EXPECT_THROW(parameterize_to_square(plane, {0, 24, 4, 20}), std::invalid_argument);  // not cyclic
   EXPECT_EQ(parameterize_to_square(plane, {0, 20, 24, 4}).orientation, -1);            // cyclic, against the rim
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Rim chords (surface/rim_chords.hpp): interior edges joining two rim vertices.
+
+double total_area(const TriangleSurface& surface) {
+  double area = 0.0;
+  for (const auto& [a, b, c] : surface.triangles)
+    area += 0.5 * (surface.points[b] - surface.points[a]).cross(surface.points[c] - surface.points[a]).norm();
+  return area;
+}
+
+TEST(RimChords, ASawtoothRimMapsOneToOneOnceItsChordsAreSplit) {
+  // Each tooth's base is a chord with the tooth's apex alone on its short arc: a corner must sit on every
+  // apex, and eight teeth need more than four corners.
+  const TriangleSurface patch = testing::sawtooth_patch(8);
+  ASSERT_EQ(count_rim_chords(patch), 8 + 2);  // and the grid's own, cutting off its corners (8, 0) and (0, 8)
+  EXPECT_THAT(meshing_error([&] { corners_by_arc_length(patch); }), HasSubstr("no choice of corners"));
+
+  const TriangleSurface split = split_rim_chords(patch);
+  EXPECT_EQ(count_rim_chords(split), 0);
+  ASSERT_EQ(split.points.size(), patch.points.size() + 10);
+  EXPECT_EQ(split.triangles.size(), patch.triangles.size() + 20);
+  for (std::size_t i = 0; i < patch.points.size(); ++i) EXPECT_EQ(split.points[i], patch.points[i]) << "point " << i;
+  EXPECT_NO_THROW(require_surface_topology(split));
+  EXPECT_EQ(rim_loop(split), rim_loop(patch));
+  EXPECT_NEAR(total_area(split), total_area(patch), 1e-14);
+  // Each new point is the midpoint of a chord, so it lies on the patch: the geometry did not change.
+  const TriangleBVH tree(patch);
+  for (std::size_t i = patch.points.size(); i < split.points.size(); ++i)
+    EXPECT_LT(tree.closest_point(split.points[i]).squared_distance, 1e-30) << "point " << i;
+  for (FloaterWeights weights : both_weights)
+    expect_bijective(split, parameterize_to_square(split, corners_by_arc_length(split), weights),
+                     weights_name(weights));
+}
+
+TEST(RimChords, AreSplitAlikeWhateverThePoints) {
+  // A moving surface keeps its triangulation: its split must not depend on where its points are.
+  const TriangleSurface patch = testing::sawtooth_patch(6);
+  TriangleSurface moved = patch;
+  for (Vector3d& p : moved.points) p = Vector3d(p.z(), -p.x(), 2.0 * p.y());
+  EXPECT_EQ(split_rim_chords(moved).triangles, split_rim_chords(patch).triangles);
+}
+
+TEST(RimChords, ASurfaceWithoutChordsIsUnchanged) {
+  const TriangleSurface cap = testing::spherical_cap(6);
+  ASSERT_EQ(count_rim_chords(cap), 0);
+  const TriangleSurface split = split_rim_chords(cap);
+  EXPECT_EQ(split.points, cap.points);
+  EXPECT_EQ(split.triangles, cap.triangles);
 }
 
 }  // namespace

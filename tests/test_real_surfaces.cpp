@@ -11,6 +11,7 @@
 // so that a change that brings back the chords across creases fails.
 
 #include <meccano/error.hpp>
+#include <meccano/geometry/geometry.hpp>
 #include <meccano/inspect/mesh_file_measure.hpp>
 #include <meccano/io/mesh_writers.hpp>
 #include <meccano/io/surface_readers.hpp>
@@ -177,6 +178,22 @@ TEST(WesternSantaCruzIsland, IsInsertedAtE50AndE70WithoutRetries) {
     EXPECT_NEAR(static_cast<double>(result.estimated_tets) / tets, 1.0, 0.3)
         << result.estimated_tets << " for " << tets;
   }
+}
+
+// A surface trimmed along its triangles (a fault model cut to a region) has a sawtooth rim: a rim edge
+// whose triangle sticks out joins two rim vertices of the rest. Before such chords were split, S's own
+// parameterization failed for want of corners at every l_r, and so did the insertion.
+TEST(TrimmedRim, ASawtoothRimIsInsertedAtTheResolutionAsked) {
+  const TriangleSurface surface = testing::sawtooth_patch(10);
+  InsertionOptions options;
+  options.resolution = 1.0 / 16;
+  const InsertionResult result = insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {&surface, 1}, options);
+  EXPECT_TRUE(result.finer_retries.empty()) << result.finer_retries.front();
+  const MeshInvariantReport check = verify_mesh(result.mesh);
+  EXPECT_TRUE(check.ok()) << check.summary();
+  const TriangleBVH tree(surface);
+  for (const VertexId v : result.surfaces[0].projection.nodes)
+    EXPECT_LT(tree.closest_point(result.mesh.points[v]).squared_distance, 1e-18) << "S_M node " << v << " off S";
 }
 
 }  // namespace

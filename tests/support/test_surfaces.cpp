@@ -56,6 +56,19 @@ TriangleSurface graph_patch(const std::function<double(double, double)>& f, std:
       n, n, std::move(name));
 }
 
+TriangleSurface sawtooth_patch(int n) {
+  const auto height = [](double x, double y) { return 0.45 + 0.06 * std::sin(2 * pi * x) + 0.1 * y; };
+  TriangleSurface surface = graph_patch(height, {0.2, 0.8}, {0.2, 0.8}, n, "sawtooth");
+  const double cell = 0.6 / n;
+  for (int k = 0; k < n; ++k) {
+    const double x = 0.2 + (k + 0.5) * cell;
+    const int apex = static_cast<int>(surface.points.size());
+    surface.points.emplace_back(x, 0.2 - 0.6 * cell, height(x, 0.2 - 0.6 * cell));
+    surface.triangles.push_back({k + 1, k, apex});  // the patch has edge k -> k + 1: the tooth runs against it
+  }
+  return surface;
+}
+
 TriangleSurface tilted_plane(int n) {
   return graph_patch([](double x, double y) { return 0.35 + 0.3 * x + 0.1 * y; }, {0.1, 0.9}, {0.1, 0.9}, n,
                      "tilted_plane");

@@ -29,6 +29,10 @@ TriangleSurface saddle(int n);                     // z = 0.5 + 1.2 (x - 0.5)(y 
 TriangleSurface spherical_cap(int n);              // radius 0.4, polar angle 65 degrees, circular rim, n rings
 TriangleSurface strongly_curved_sheet(int n);      // 220-degree sector of a cylinder of radius 0.3 (axis y)
 std::vector<TriangleSurface> stacked_pair(int n);  // two parallel bumps, 0.3 apart in z
+// A wavy n x n patch over [0.2, 0.8]^2 with a sawtooth rim: a triangle (a tooth) on each of its n rim
+// edges at y = 0.2, so those edges join two rim vertices, like the rim of a surface trimmed along its
+// triangles (tooth k's apex is point (n + 1)^2 + k).
+TriangleSurface sawtooth_patch(int n);
 // The paper-like patch of shared/notes/peers.md section 6: over (x, y) in [0.2, 0.8]^2,
 // z = 0.42 + 0.12 u v + 0.10 sin(pi u) sin(pi v), u = (x - 0.2) / 0.6, v = (y - 0.2) / 0.6.
 TriangleSurface paper_like_patch(int n);

@@ -4,6 +4,7 @@
 #include <meccano/geometry/geometry.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/mesh/invariants.hpp>
+#include <meccano/surface/rim_chords.hpp>
 
 #include "mesh/topology_helpers.hpp"
 
@@ -600,9 +601,20 @@ double finer_resolution(const MeccanoGrid& meccano, const Clearances& clearance,
 }
 
 // The insertion at l_r, and where it fails, again with the failing surfaces at a finer l_r.
-InsertionResult insert_surfaces(const TetMesh& mesh, std::span<const TriangleSurface> surfaces,
+// The surfaces as the stages take them: with their rim chords split (surface/rim_chords.hpp), so that
+// S's parameterization is one-to-one whatever the corners.
+std::vector<TriangleSurface> without_rim_chords(std::span<const TriangleSurface> surfaces) {
+  std::vector<TriangleSurface> split;
+  split.reserve(surfaces.size());
+  for (const TriangleSurface& surface : surfaces) split.push_back(split_rim_chords(surface));
+  return split;
+}
+
+InsertionResult insert_surfaces(const TetMesh& mesh, std::span<const TriangleSurface> input_surfaces,
                                 const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();
+  const std::vector<TriangleSurface> split_surfaces = without_rim_chords(input_surfaces);
+  const std::span<const TriangleSurface> surfaces(split_surfaces);
   std::int64_t estimated_tets = mesh.num_tets();
   if (!surfaces.empty()) {
     if (!(options.resolution > 0.0))
@@ -811,7 +823,7 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
     moved.healing_stats = was.healing_stats;
     const SurfaceProjection& from = was.projection;
     SurfaceProjection& to = moved.projection;
-    to.surface = moved_parameterization(*from.surface, surfaces[s]);
+    to.surface = moved_parameterization(*from.surface, split_rim_chords(surfaces[s]));
     to.nodes = from.nodes;
     to.uv = from.uv;
     to.on_rim = from.on_rim;

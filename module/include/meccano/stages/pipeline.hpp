@@ -1,6 +1,8 @@
 // The whole insertion, read top-down like the paper's four steps.
 //
 // Input    a meccano mesh (mesh/cube_meccano.hpp), surfaces that passed validate_surfaces, and options.
+//          The stages take each surface with its rim chords split (surface/rim_chords.hpp): the same
+//          geometry, a triangulation whose parameterization cannot fail for want of corners.
 // Steps    1. volumetric approximation V_M of each surface (stages/volumetric_approximation.hpp);
 //          2. surface approximation S_M of each surface, healed (stages/surface_approximation.hpp); once all
 //             are built, any S_M that a later surface's refinement disturbed is healed again;

@@ -600,7 +600,6 @@ double finer_resolution(const MeccanoGrid& meccano, const Clearances& clearance,
   return finer;
 }
 
-// The insertion at l_r, and where it fails, again with the failing surfaces at a finer l_r.
 // The surfaces as the stages take them: with their rim chords split (surface/rim_chords.hpp), so that
 // S's parameterization is one-to-one whatever the corners.
 std::vector<TriangleSurface> without_rim_chords(std::span<const TriangleSurface> surfaces) {
@@ -610,6 +609,7 @@ std::vector<TriangleSurface> without_rim_chords(std::span<const TriangleSurface>
   return split;
 }
 
+// The insertion at l_r, and where it fails, again with the failing surfaces at a finer l_r.
 InsertionResult insert_surfaces(const TetMesh& mesh, std::span<const TriangleSurface> input_surfaces,
                                 const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();

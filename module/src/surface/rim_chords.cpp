@@ -35,27 +35,23 @@ class EdgeTriangles {
     }
   }
   // Interior edges (two triangles) whose ends are both rim vertices, in a fixed order.
-  std::vector<std::pair<int, int>> rim_chords() const {
-    std::vector<std::uint8_t> on_rim;
-    for (const auto& [key, triangles] : map_) {
-      if (triangles.size() != 1) continue;
-      for (const int v : {static_cast<int>(key >> 32), static_cast<int>(key & 0xffffffffU)}) {
-        if (static_cast<std::size_t>(v) >= on_rim.size()) on_rim.resize(v + 1, 0);
-        on_rim[v] = 1;
-      }
-    }
-    const auto rim = [&](int v) { return static_cast<std::size_t>(v) < on_rim.size() && on_rim[v] != 0; };
+  std::vector<std::pair<int, int>> rim_chords(std::size_t vertex_count) const {
+    std::vector<std::uint8_t> on_rim(vertex_count, 0);
+    for (const auto& [key, triangles] : map_)
+      if (triangles.size() == 1) on_rim[ends(key).first] = on_rim[ends(key).second] = 1;
     std::vector<std::pair<int, int>> chords;
     for (const auto& [key, triangles] : map_) {
-      const int a = static_cast<int>(key >> 32);
-      const int b = static_cast<int>(key & 0xffffffffU);
-      if (triangles.size() == 2 && rim(a) && rim(b)) chords.emplace_back(a, b);
+      const auto [a, b] = ends(key);
+      if (triangles.size() == 2 && on_rim[a] && on_rim[b]) chords.emplace_back(a, b);
     }
     std::ranges::sort(chords);  // the map's order depends on the library; the split must not
     return chords;
   }
 
  private:
+  static std::pair<int, int> ends(std::uint64_t key) {
+    return {static_cast<int>(key >> 32), static_cast<int>(key & 0xffffffffU)};
+  }
   std::unordered_map<std::uint64_t, std::vector<int>> map_;
 };
 
@@ -70,7 +66,7 @@ Triangle chord_first(const Triangle& t, int a, int b) {
 }  // namespace
 
 int count_rim_chords(const TriangleSurface& surface) {
-  return static_cast<int>(EdgeTriangles(surface.triangles).rim_chords().size());
+  return static_cast<int>(EdgeTriangles(surface.triangles).rim_chords(surface.points.size()).size());
 }
 
 TriangleSurface split_rim_chords(const TriangleSurface& surface) {
@@ -78,7 +74,7 @@ TriangleSurface split_rim_chords(const TriangleSurface& surface) {
   EdgeTriangles edges(split.triangles);
   // Splitting a chord adds edges to the new vertex only, which is interior: no chord appears, and the
   // others stay edges (of the halves), so one pass over the chords found at the start splits them all.
-  for (const auto& [a, b] : edges.rim_chords()) {
+  for (const auto& [a, b] : edges.rim_chords(surface.points.size())) {
     const int m = static_cast<int>(split.points.size());
     split.points.push_back(0.5 * (split.points[a] + split.points[b]));
     const std::vector<int> sides = edges.on(a, b);  // a copy: the splits below change the map

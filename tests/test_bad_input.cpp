@@ -15,7 +15,8 @@
 // | out-of-range indices                   | "vertex index 9 out of range (1..3)"                 | SurfaceIo.ObjIndexOutOfRange, OffIndexOutOfRange,     |
 // |                                        | "node N is not defined in $Nodes"                    | MshUndefinedNode; SurfaceTopology.IndexOutOfRange;    |
 // |                                        |                                                      | Check.ReaderErrors...                                 |
-// | closed surface                         | "closed"                                             | SurfaceTopology.ClosedSurface                         |
+// | closed surface of genus above 0        | "closed surface of genus 1"                          | SurfaceTopology.ClosedSurfacesOfGenusZeroPass...;     |
+// |                                        |                                                      | ClosedSurface.ATorusIsRefused                         |
 // | surface crossing the box boundary      | "vertex 11 (...) is outside the box [0, 1] x ..."    | GeometryChecks.SurfaceOutsideTheBox; CliTest.BadSurfa-|
 // |                                        |                                                      | cesFailWithTheirOwnMessageAndWriteNothing             |
 // | surface touching the box boundary      | "on the box boundary"                                | GeometryChecks.VertexOnTheBoxBoundary; CliTest.BadSu..|

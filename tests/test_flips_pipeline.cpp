@@ -35,7 +35,7 @@ void expect_interface_on_surface(const InsertionResult& result, std::span<const 
   for (std::size_t s = 0; s < surfaces.size(); ++s) {
     const TriangleSurface& surface = surfaces[s];
     const TriangleBVH tree(surface);
-    const SurfaceProjection& projection = result.surfaces[s].projection;
+    const SurfaceProjection& projection = result.surfaces[s].projections.front();
     std::set<std::array<VertexId, 3>> listed, tagged;
     for (const auto& triangle : projection.triangles) {
       std::array<VertexId, 3> key{projection.nodes[triangle[0]], projection.nodes[triangle[1]],
@@ -113,8 +113,8 @@ TEST(Creases, MendedAfterSmoothingPutSurfaceNodesOnTheLines) {
   const FlipStats& flips = mended.improvement->flips;
   EXPECT_GT(flips.crease_moves, 0);
   EXPECT_GT(flips.crease_splits, 0);
-  const SurfaceProjection& before = smoothed.surfaces[0].projection;
-  const SurfaceProjection& after = mended.surfaces[0].projection;
+  const SurfaceProjection& before = smoothed.surfaces[0].projections.front();
+  const SurfaceProjection& after = mended.surfaces[0].projections.front();
   const auto left_before = straddling_crossings(before.creases, before.triangles, before.uv).size();
   const auto left_after = straddling_crossings(after.creases, after.triangles, after.uv).size();
   EXPECT_LT(2 * left_after, left_before) << "the mends should settle most crossings";

@@ -127,7 +127,7 @@ TEST(Improvement, RunsAfterSmoothingAndKeepsTheInterfaceOnS) {
   EXPECT_TRUE(verify_mesh(improved.mesh, {.physical = true}).ok());
   for (std::size_t s = 0; s < c.surfaces.size(); ++s) {
     const TriangleBVH tree(c.surfaces[s]);
-    for (VertexId v : improved.surfaces[s].projection.nodes)
+    for (VertexId v : improved.surfaces[s].projections.front().nodes)
       ASSERT_LE(std::sqrt(tree.closest_point(improved.mesh.points[v]).squared_distance), 1e-12 * c.box.diagonal());
   }
 }

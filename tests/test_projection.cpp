@@ -60,7 +60,7 @@ TEST_P(ProjectionOn, PutsEveryNodeOnSAndTheRimOnTheRim) {
   for (std::size_t s = 0; s < c.surfaces.size(); ++s) {
     SCOPED_TRACE("surface " + std::to_string(s + 1));
     const TriangleSurface& surface = c.surfaces[s];
-    const SurfaceProjection& projection = result.surfaces[s].projection;
+    const SurfaceProjection& projection = result.surfaces[s].projections.front();
     const TriangleBVH tree(surface);
     ASSERT_GT(projection.stats.nodes, 0);
     for (std::size_t i = 0; i < projection.nodes.size(); ++i) {
@@ -161,7 +161,7 @@ TEST(Creases, ARoofKeepsItsRidgeThroughSmoothing) {
     options.projection.crease_angle = crease_angle;
     const InsertionResult result = insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {&roof, 1}, options);
     EXPECT_TRUE(verify_mesh(result.mesh).ok());
-    const SurfaceProjection& projection = result.surfaces[0].projection;
+    const SurfaceProjection& projection = result.surfaces[0].projections.front();
     for (std::size_t i = 0; i < projection.nodes.size(); ++i) {
       if (projection.creases.line_of[i] < 0) continue;
       const Eigen::Vector3d& x = result.mesh.points[projection.nodes[i]];

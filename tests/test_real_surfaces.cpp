@@ -125,7 +125,8 @@ TEST(ThinTail, AnUncoveredPartOfSFailsBeforeSmoothingAndIsRetriedFiner) {
   EXPECT_NE(reason.find("on the other side: tail: S_M leaves part of S uncovered"), std::string::npos) << reason;
   EXPECT_EQ(reason.find("sweeps"), std::string::npos) << "smoothing ran first: " << reason;
   EXPECT_TRUE(verify_mesh(result.mesh).ok());
-  EXPECT_LE(result.surfaces[0].projection.stats.rim_gap, max_rim_gap_in_resolutions * result.surfaces[0].resolution);
+  EXPECT_LE(result.surfaces[0].projections.front().stats.rim_gap,
+            max_rim_gap_in_resolutions * result.surfaces[0].resolution);
   EXPECT_LT(result.surfaces[0].resolution, options.resolution);
 
   options.finer_retries = 0;
@@ -153,7 +154,7 @@ TEST(SharpTip, AnUncoveredTipIsInsertedFromTheOtherSideAtTheResolutionAsked) {
   EXPECT_NE(result.side_retry.find("S_M leaves part of S uncovered"), std::string::npos) << result.side_retry;
   EXPECT_EQ(result.surfaces[0].healing_stats.side, -1);
   EXPECT_TRUE(verify_mesh(result.mesh).ok());
-  EXPECT_LE(result.surfaces[0].projection.stats.rim_gap, max_rim_gap_in_resolutions * options.resolution);
+  EXPECT_LE(result.surfaces[0].projections.front().stats.rim_gap, max_rim_gap_in_resolutions * options.resolution);
 }
 
 // Western Santa Cruz Island at E/50 and E/70: before S_M's triangles had a floor on their area in P,
@@ -192,7 +193,7 @@ TEST(TrimmedRim, ASawtoothRimIsInsertedAtTheResolutionAsked) {
   const MeshInvariantReport check = verify_mesh(result.mesh);
   EXPECT_TRUE(check.ok()) << check.summary();
   const TriangleBVH tree(surface);
-  for (const VertexId v : result.surfaces[0].projection.nodes)
+  for (const VertexId v : result.surfaces[0].projections.front().nodes)
     EXPECT_LT(tree.closest_point(result.mesh.points[v]).squared_distance, 1e-18) << "S_M node " << v << " off S";
 }
 

@@ -51,7 +51,7 @@ InsertionOptions band_options() {
 double largest_node_distance(const InsertionResult& result, const TriangleSurface& surface) {
   const TriangleBVH tree(surface);
   double largest = 0.0;
-  for (const VertexId v : result.surfaces.front().projection.nodes)
+  for (const VertexId v : result.surfaces.front().projections.front().nodes)
     largest = std::max(largest, (tree.closest_point(result.mesh.points[v]).point - result.mesh.points[v]).norm());
   return largest;
 }
@@ -90,12 +90,12 @@ TEST(MoveSurfaces, MovesTheInterfaceOntoTheMovedSurfaceAndLeavesTheRestAsItWas) 
   EXPECT_GT(largest_node_distance(inserted, after.front()), resolution / 8) << "the surface did move";
   const auto interfaces = surface_interfaces(moved);
   ASSERT_EQ(interfaces.size(), 1u);
-  EXPECT_EQ(interfaces.front().faces.size(), moved.surfaces.front().projection.triangles.size());
+  EXPECT_EQ(interfaces.front().faces.size(), moved.surfaces.front().projections.front().triangles.size());
 
   // Only the S_M nodes and the nodes within the band around them (the dragged rings and one more) may
   // move; the others keep the previous step's position exactly.
   const std::vector<VertexId> previous = match_previous_nodes(inserted.mesh, moved.mesh);
-  const std::vector<VertexId>& interface_nodes = moved.surfaces.front().projection.nodes;
+  const std::vector<VertexId>& interface_nodes = moved.surfaces.front().projections.front().nodes;
   for (const VertexId v : interface_nodes) EXPECT_EQ(previous[v], no_previous_node);
   std::vector<std::uint8_t> in_band(moved.mesh.points.size(), 0);
   std::vector<VertexId> ring = interface_nodes;

@@ -161,7 +161,7 @@ TEST_P(SmoothingOn, UntanglesKeepsTheInterfaceOnSAndReachesThePapersQuality) {
   const double tolerance = 1e-12 * c.box.diagonal();
   for (std::size_t s = 0; s < c.surfaces.size(); ++s) {
     SCOPED_TRACE("surface " + std::to_string(s + 1));
-    const SurfaceProjection& projection = result.surfaces[s].projection;
+    const SurfaceProjection& projection = result.surfaces[s].projections.front();
     const TriangleBVH tree(c.surfaces[s]);
     for (std::size_t i = 0; i < projection.nodes.size(); ++i) {
       const Eigen::Vector3d& x = result.mesh.points[projection.nodes[i]];
@@ -238,7 +238,7 @@ TEST(Smoothing, BandModeMovesOnlyNodesNearTheSurface) {
 
   // Edge rings from S_M, found independently of the smoother.
   std::vector<int> ring(result.mesh.points.size(), -1);
-  std::vector<VertexId> front = result.surfaces[0].projection.nodes;
+  std::vector<VertexId> front = result.surfaces[0].projections.front().nodes;
   for (VertexId v : front) ring[v] = 0;
   const VertexTets stars = vertex_to_tets(result.mesh);
   for (int r = 1; !front.empty(); ++r) {
@@ -254,7 +254,7 @@ TEST(Smoothing, BandModeMovesOnlyNodesNearTheSurface) {
   }
 
   SmoothingOptions band{.mode = SmoothingMode::band, .band_rings = 2};
-  std::vector<SurfaceProjection*> projections{&result.surfaces[0].projection};
+  std::vector<SurfaceProjection*> projections{&result.surfaces[0].projections.front()};
   const SmoothingStats stats = smooth_mesh(result.mesh, projections, band);
   EXPECT_TRUE(stats.untangled());
   EXPECT_GT(stats.inverted_before, 0);
@@ -283,7 +283,7 @@ TEST(Smoothing, FallsBackToTheEquilateralTargetWhereTheMeccanoTargetStalls) {
   ASSERT_FALSE(result.smoothing.sweeps.empty());
   EXPECT_EQ(result.smoothing.sweeps.back().target, SmoothingTarget::meccano);
   EXPECT_TRUE(verify_mesh(result.mesh, {.physical = true}).ok());
-  EXPECT_EQ(folded_triangles(result.surfaces[0].projection), 0);
+  EXPECT_EQ(folded_triangles(result.surfaces[0].projections.front()), 0);
   // 0.254 before S_M's triangles had a floor on their area in P, 0.245 since (and the equilateral minimum
   // 0.16 -> 0.21, the smallest dihedral angle 5.0 -> 6.4 degrees).
   EXPECT_GE(result.quality_after_smoothing.meccano.min, 0.24);
@@ -305,7 +305,7 @@ TEST(Smoothing, UntanglesTowardsTheEquilateralTarget) {
       insert({&surface, 1}, {{0, 0, 0}, {1, 1, 1}}, 1.0 / 16, {.target = SmoothingTarget::equilateral});
   EXPECT_TRUE(result.smoothing.untangled());
   EXPECT_TRUE(verify_mesh(result.mesh, {.physical = true}).ok());
-  EXPECT_EQ(folded_triangles(result.surfaces[0].projection), 0);
+  EXPECT_EQ(folded_triangles(result.surfaces[0].projections.front()), 0);
 }
 
 }  // namespace

@@ -76,8 +76,9 @@ TriangleSurface annulus() {
   return make_surface(std::move(points), std::move(triangles));
 }
 
-// A 4 x 4 torus with one triangle removed: one boundary loop but a handle (V - E + F = -1).
-TriangleSurface punctured_torus() {
+// A 4 x 4 torus (closed, genus 1), or with one triangle removed: one boundary loop but a handle
+// (V - E + F = -1).
+TriangleSurface torus(bool punctured) {
   constexpr int n = 4;
   std::vector<Eigen::Vector3d> points;
   std::vector<std::array<int, 3>> triangles;
@@ -93,7 +94,7 @@ TriangleSurface punctured_torus() {
       triangles.push_back({index(i, j), index(i + 1, j), index(i + 1, j + 1)});
       triangles.push_back({index(i, j), index(i + 1, j + 1), index(i, j + 1)});
     }
-  triangles.pop_back();
+  if (punctured) triangles.pop_back();
   return make_surface(std::move(points), std::move(triangles));
 }
 
@@ -214,8 +215,11 @@ TEST(SurfaceTopology, TwoFansOfAGridTouchingAtACorner) {
               HasSubstr("patch.obj: non-manifold vertex 9: its triangles form 2 separate fans"));
 }
 
-TEST(SurfaceTopology, ClosedSurface) {
-  EXPECT_THAT(topology_error(octahedron()), HasSubstr("patch.obj: closed surface (no boundary edges)"));
+TEST(SurfaceTopology, ClosedSurfacesOfGenusZeroPassOthersNot) {
+  EXPECT_NO_THROW(meccano::require_surface_topology(octahedron()));
+  EXPECT_THAT(topology_error(torus(false)),
+              HasSubstr("patch.obj: closed surface of genus 1 (Euler characteristic V - E + F = 16 - 48 + 32 = 0 "
+                        "instead of 2): only closed surfaces of genus 0 (spheres) are supported"));
 }
 
 TEST(SurfaceTopology, Annulus) {
@@ -223,12 +227,12 @@ TEST(SurfaceTopology, Annulus) {
 }
 
 TEST(SurfaceTopology, Handle) {
-  EXPECT_THAT(topology_error(punctured_torus()),
+  EXPECT_THAT(topology_error(torus(true)),
               HasSubstr("patch.obj: not a topological disk: Euler characteristic V - E + F = 16 - 48 + 31 = -1"));
 }
 
 TEST(SurfaceTopology, ReportsTheFirstDefectInOrder) {
-  // An octahedron plus a separate triangle: the components are reported before the missing boundary.
+  // An octahedron plus a separate triangle: the components are reported first, before the topology of each.
   TriangleSurface surface = octahedron();
   for (const Eigen::Vector3d& p : {Eigen::Vector3d(5, 0, 0), Eigen::Vector3d(6, 0, 0), Eigen::Vector3d(5, 1, 0)})
     surface.points.push_back(p);
@@ -237,11 +241,11 @@ TEST(SurfaceTopology, ReportsTheFirstDefectInOrder) {
 }
 
 TEST(SurfaceTopology, MessageNamesTheSurface) {
-  TriangleSurface surface = octahedron();
+  TriangleSurface surface = torus(false);
   surface.source.clear();
-  EXPECT_THAT(topology_error(surface), HasSubstr("patch: closed surface"));
+  EXPECT_THAT(topology_error(surface), HasSubstr("patch: closed surface of genus 1"));
   surface.name.clear();
-  EXPECT_THAT(topology_error(surface), HasSubstr("surface: closed surface"));
+  EXPECT_THAT(topology_error(surface), HasSubstr("surface: closed surface of genus 1"));
 }
 
 }  // namespace

@@ -162,6 +162,76 @@ TriangleSurface paper_like_patch(int n) {
       {0.2, 0.8}, {0.2, 0.8}, n, "paper_like");
 }
 
+namespace {
+
+// The octahedron |x| + |y| + |z| = 1, each face cut into n^2 triangles, its points mapped by `place` (a
+// function of the unit direction), normals pointing out.
+TriangleSurface octahedral_sphere(const std::function<Vector3d(const Vector3d&)>& place, int n, std::string name) {
+  TriangleSurface surface;
+  surface.name = std::move(name);
+  std::map<std::array<int, 3>, int> index;  // integer point on the octahedron, times n
+  auto point = [&](const std::array<int, 3>& q) {
+    const auto [it, added] = index.try_emplace(q, static_cast<int>(surface.points.size()));
+    if (added) surface.points.push_back(place(Vector3d(q[0], q[1], q[2]).normalized()));
+    return it->second;
+  };
+  for (int face = 0; face < 8; ++face) {
+    const std::array<int, 3> sign{face & 1 ? -1 : 1, face & 2 ? -1 : 1, face & 4 ? -1 : 1};
+    auto at = [&](int a, int b) { return point({sign[0] * a, sign[1] * b, sign[2] * (n - a - b)}); };
+    auto add = [&](int p, int q, int r) {
+      // Out of the octahedron: along the face's normal (sign).
+      const Vector3d normal = (surface.points[q] - surface.points[p]).cross(surface.points[r] - surface.points[p]);
+      if (normal.dot(Vector3d(sign[0], sign[1], sign[2])) < 0) std::swap(q, r);
+      surface.triangles.push_back({p, q, r});
+    };
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; a + b < n; ++b) {
+        add(at(a, b), at(a + 1, b), at(a, b + 1));
+        if (a + b + 2 <= n) add(at(a + 1, b), at(a + 1, b + 1), at(a, b + 1));
+      }
+  }
+  return surface;
+}
+
+}  // namespace
+
+TriangleSurface ellipsoid(const Vector3d& centre, const Vector3d& radii, int n, std::string name) {
+  return octahedral_sphere([&](const Vector3d& d) -> Vector3d { return centre + radii.cwiseProduct(d); }, n,
+                           std::move(name));
+}
+
+TriangleSurface sphere(int n) { return ellipsoid(Vector3d::Constant(0.5), Vector3d::Constant(0.3), n, "sphere"); }
+
+TriangleSurface bumpy_blob(int n) {
+  const std::array<Vector3d, 3> bumps{Vector3d(1, 0.3, 0.2).normalized(), Vector3d(-0.4, 1, 0.5).normalized(),
+                                      Vector3d(0.1, -0.6, -1).normalized()};
+  return octahedral_sphere(
+      [&](const Vector3d& d) -> Vector3d {
+        double b = 0.0;
+        for (const Vector3d& bump : bumps) b += std::exp(-(d - bump).squaredNorm() / 0.3);
+        return Vector3d::Constant(0.5) + 0.25 * (1.0 + 0.25 * b) * d;
+      },
+      n, "bumpy_blob");
+}
+
+TriangleSurface closed_torus(int n) {
+  TriangleSurface surface;
+  surface.name = "torus";
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const double u = 2 * pi * i / n, v = 2 * pi * j / n;
+      surface.points.push_back(Vector3d(0.5 + (0.25 + 0.1 * std::cos(v)) * std::cos(u),
+                                        0.5 + (0.25 + 0.1 * std::cos(v)) * std::sin(u), 0.5 + 0.1 * std::sin(v)));
+    }
+  auto at = [n](int i, int j) { return (j % n) * n + (i % n); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      surface.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      surface.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return surface;
+}
+
 std::vector<NamedSurfaces> named_test_surfaces(int n) {
   TriangleSurface irregular = perturbed(paper_like_patch(n), 0.2, 1);
   irregular.name = "perturbed_paper_like";

@@ -37,6 +37,17 @@ TriangleSurface sawtooth_patch(int n);
 // z = 0.42 + 0.12 u v + 0.10 sin(pi u) sin(pi v), u = (x - 0.2) / 0.6, v = (y - 0.2) / 0.6.
 TriangleSurface paper_like_patch(int n);
 
+// Closed surfaces (issue 19), normals pointing out. The octahedron |x| + |y| + |z| = 1 with each face cut into
+// n^2 triangles, its points pushed onto the ellipsoid with these centre and radii.
+TriangleSurface ellipsoid(const Eigen::Vector3d& centre, const Eigen::Vector3d& radii, int n,
+                          std::string name = "ellipsoid");
+TriangleSurface sphere(int n);  // centre (0.5, 0.5, 0.5), radius 0.3
+// A star-shaped blob: the sphere of radius 0.25 about (0.5, 0.5, 0.5) with radius 0.25 (1 + 0.25 b(d)), b a
+// sum of three smooth bumps over the unit directions d.
+TriangleSurface bumpy_blob(int n);
+// A torus (genus 1) of radii 0.25 and 0.1 about (0.5, 0.5, 0.5), n x n cells: closed, but not a sphere.
+TriangleSurface closed_torus(int n);
+
 struct NamedSurfaces {
   std::string name;
   std::vector<TriangleSurface> surfaces;

@@ -43,6 +43,8 @@ class MeshFileChecker {
     report.checks.push_back(box_sides());
     for (const MshGroup& group : mesh_.groups)
       if (group.dimension == 2 && group.name.starts_with("interface_")) report.checks.push_back(interface(group));
+    for (const MshGroup& group : mesh_.groups)
+      if (group.dimension == 3 && group.name.starts_with("inside_")) report.checks.push_back(inside(group));
     return report;
   }
 
@@ -222,12 +224,16 @@ class MeshFileChecker {
     std::int64_t flipped = 0;
     for (std::size_t i = 1; i < directed.size(); ++i) flipped += directed[i] == directed[i - 1];
 
+    // An open interface is a disk, a closed one (no boundary edge) a sphere.
+    const bool closed = !triangles.empty() && topology.boundary_edges == 0;
+    const char* kind = closed ? "a closed interface" : "a disk";
     if (triangles.empty()) problem(check, "the group has no triangles");
-    if (topology.components > 1) problem(check, topology.components, " connected components (a disk has one)");
+    if (topology.components > 1) problem(check, topology.components, " connected components (", kind, " has one)");
     if (topology.overloaded_edges > 0) problem(check, topology.overloaded_edges, " edges in more than two triangles");
     if (topology.pinched_vertices > 0) problem(check, topology.pinched_vertices, " pinched vertices");
-    if (topology.euler() != 1) problem(check, "Euler characteristic ", topology.euler(), " (a disk has 1)");
-    if (boundary_loops != 1) problem(check, boundary_loops, " boundary loops (a disk has one)");
+    if (topology.euler() != (closed ? 2 : 1))
+      problem(check, "Euler characteristic ", topology.euler(), " (", kind, " has ", closed ? 2 : 1, ")");
+    if (!closed && boundary_loops != 1) problem(check, boundary_loops, " boundary loops (a disk has one)");
     if (flipped > 0) problem(check, flipped, " edges run twice in the same direction (inconsistent orientation)");
     // Not a defect of the mesh, but a fault solver that splits the interface's nodes needs a node off the
     // interface in every tet: counted, not failed (a coarse mesh that keeps the surface may have some).
@@ -237,6 +243,59 @@ class MeshFileChecker {
     check.summary = std::to_string(triangles.size()) + " triangles, Euler characteristic " +
                     std::to_string(topology.euler()) + ", " + std::to_string(boundary_loops) + " boundary loop(s)";
     if (lying_on > 0) check.summary += ", " + std::to_string(lying_on) + " tets with all four nodes on it";
+    return check;
+  }
+
+  // inside_NAME: the tets a closed interface_NAME encloses. Across each of its faces the group has one
+  // tet, whose outward normal is the face's (interface faces point out of an inclusion); every other
+  // face between a tet of the group and one outside it is an interface face; no tet of it is on the box.
+  CheckResult inside(const MshGroup& group) const {
+    CheckResult check = named(group.name);
+    const std::string interface_name = "interface_" + group.name.substr(std::string("inside_").size());
+    const auto interface = std::ranges::find_if(
+        mesh_.groups, [&](const MshGroup& g) { return g.dimension == 2 && g.name == interface_name; });
+    if (interface == mesh_.groups.end()) {
+      problem(check, "no 2D group ", interface_name, " bounds it");
+      return check;
+    }
+    std::vector<std::uint8_t> member(mesh_.tets.size(), 0);
+    for (const int t : group.elements) member[t] = 1;
+    std::vector<Face> bounding;
+    for (const int e : interface->elements) {
+      const Face& face = mesh_.triangles[e];
+      Face key = face;
+      std::ranges::sort(key);
+      bounding.push_back(key);
+      const auto sharing = tets_with(key);
+      const auto inner = std::ranges::find_if(sharing, [&](const FaceRecord& r) { return member[r.tet] != 0; });
+      if (sharing.size() != 2 ||
+          std::ranges::count_if(sharing, [&](const FaceRecord& r) { return member[r.tet]; }) != 1) {
+        problem(check, "triangle ", mesh_.triangle_tags[e], " of ", interface_name,
+                " does not have one tet of the group behind it");
+        continue;
+      }
+      // The tet's vertex off the face lies behind the face's normal.
+      const auto& tet = mesh_.tets[inner->tet];
+      const int apex = *std::ranges::find_if(tet, [&](int v) { return std::ranges::find(face, v) == face.end(); });
+      const Eigen::Vector3d& a = mesh_.points[face[0]];
+      const Eigen::Vector3d normal = (mesh_.points[face[1]] - a).cross(mesh_.points[face[2]] - a);
+      if (!(normal.dot(mesh_.points[apex] - a) < 0.0))
+        problem(check, "triangle ", mesh_.triangle_tags[e], " of ", interface_name, " points into ",
+                tet_name(inner->tet));
+    }
+    std::ranges::sort(bounding);
+    CompensatedSum volume;
+    for (const int t : group.elements) volume.add(tet_volume(t));
+    for_each_face([&](std::span<const FaceRecord> sharing) {
+      const auto members = std::ranges::count_if(sharing, [&](const FaceRecord& r) { return member[r.tet]; });
+      if (sharing.size() == 1 && members == 1) problem(check, tet_name(sharing[0].tet), " is on the box boundary");
+      else if (sharing.size() == 2 && members == 1 && !std::ranges::binary_search(bounding, sharing[0].key))
+        problem(check, face_name(sharing[0].key), " between ", tet_name(sharing[0].tet), " and ",
+                tet_name(sharing[1].tet), " leaves the group without crossing ", interface_name);
+    });
+    std::ostringstream summary;
+    summary << group.elements.size() << " tets, volume " << volume.value() << ", bounded by " << interface_name;
+    check.summary = summary.str();
     return check;
   }
 

@@ -22,6 +22,7 @@ void write_quality(JsonWriter& json, const char* name, const QualitySummary& qua
 
 void write_surface(JsonWriter& json, const SurfaceInsertion& inserted, Stage last_stage) {
   json.begin_object().key("name").value(inserted.name).key("resolution").value(inserted.resolution);
+  json.key("closed").value(inserted.closed);
   const VolumetricStats& v = inserted.volumetric_stats;
   json.key("volumetric").begin_object();
   json.key("tets").value(v.tets).key("tets_meeting_surface").value(v.tets_intersecting);
@@ -46,7 +47,7 @@ void write_surface(JsonWriter& json, const SurfaceInsertion& inserted, Stage las
     json.key("seconds").value(inserted.approximation_seconds).end_object();
   }
   if (last_stage >= Stage::projection) {
-    const ProjectionStats& p = inserted.projection.stats;
+    const ProjectionStats p = inserted.projection_stats();
     json.key("projection").begin_object();
     json.key("nodes").value(p.nodes).key("rim_nodes").value(p.rim_nodes);
     json.key("largest_move").value(p.largest_move).key("largest_distance_after").value(p.largest_distance_after);

@@ -4,6 +4,7 @@
 #include <meccano/geometry/geometry.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/mesh/invariants.hpp>
+#include <meccano/surface/closed_surface.hpp>
 #include <meccano/surface/rim_chords.hpp>
 
 #include "mesh/topology_helpers.hpp"
@@ -97,7 +98,7 @@ void report_approximation(const InsertionOptions& options, const SurfaceInsertio
 }
 
 void report_projection(const InsertionOptions& options, const SurfaceInsertion& inserted) {
-  const auto& p = inserted.projection.stats;
+  const ProjectionStats p = inserted.projection_stats();
   report(options, "projection ", inserted.name, ": ", p.nodes, " nodes (", p.rim_nodes, " on the rim, ",
          p.creases.nodes, " on ", p.creases.lines, " creases) moved by up to ", p.largest_move, ", now within ",
          p.largest_distance_after, " of S; S's rim within ", p.rim_gap / inserted.resolution, " l_r of S_M's; ",
@@ -153,6 +154,7 @@ void approximate_volumes(InsertionResult& result, std::span<const TriangleSurfac
     const auto start = std::chrono::steady_clock::now();
     SurfaceInsertion& inserted = result.surfaces.emplace_back();
     inserted.name = surface.name;
+    inserted.closed = is_closed(surface);
     inserted.resolution = resolutions[index];
     std::vector<TetRegion*> earlier;
     for (int s = 0; s < index; ++s) earlier.push_back(&result.surfaces[s].volumetric);
@@ -221,10 +223,14 @@ void project_onto_surfaces(InsertionResult& result, std::span<const TriangleSurf
     ProjectionOptions projection = options.projection;
     if (require_coverage)
       projection.max_rim_gap = std::min(projection.max_rim_gap, max_rim_gap_in_resolutions * inserted.resolution);
-    inserted.projection = for_surface(s, inserted.name, [&] {
+    inserted.projections = for_surface(s, inserted.name, [&] {
       try {
-        return project_onto_surface(result.mesh, inserted.volumetric, s, inserted.healing_stats.side, surfaces[s],
-                                    trees[s], projection);
+        if (inserted.closed)
+          return project_closed_onto_surface(result.mesh, inserted.volumetric, s, surfaces[s], trees[s], projection);
+        std::vector<SurfaceProjection> disk;
+        disk.push_back(project_onto_surface(result.mesh, inserted.volumetric, s, inserted.healing_stats.side,
+                                            surfaces[s], trees[s], projection));
+        return disk;
       } catch (const UncoveredSurfaceError& uncovered) {  // for_surface passes a SurfaceFailure on as it is
         throw UncoveredFailure(s, inserted.name + ": " + uncovered.what(), sides_of(result));
       }
@@ -260,7 +266,8 @@ void lift_worst_tets(InsertionResult& result, std::span<SurfaceProjection* const
 // Step 4 and the improvement after it. False, and the mesh as SUS left it, if tets stay inverted.
 bool untangle_smooth_and_improve(InsertionResult& result, const InsertionOptions& options) {
   std::vector<SurfaceProjection*> projections;
-  for (SurfaceInsertion& inserted : result.surfaces) projections.push_back(&inserted.projection);
+  for (SurfaceInsertion& inserted : result.surfaces)
+    for (SurfaceProjection& projection : inserted.projections) projections.push_back(&projection);
   untangle_and_smooth(result, projections, options);
   if (!result.smoothing.untangled()) return false;
   check_stage(result.mesh, "smoothing");
@@ -396,7 +403,8 @@ std::vector<int> surfaces_next_to_inverted_tets(const InsertionResult& result) {
   const TetMesh& mesh = result.mesh;
   std::vector<int> surface_of(mesh.points.size(), -1);
   for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s)
-    for (VertexId v : result.surfaces[s].projection.nodes) surface_of[v] = s;
+    for (const SurfaceProjection& projection : result.surfaces[s].projections)
+      for (VertexId v : projection.nodes) surface_of[v] = s;
   std::vector<std::uint8_t> next(result.surfaces.size(), 0);
   for (TetId t = 0; t < mesh.num_tets(); ++t)
     if (is_inverted(mesh, t))
@@ -438,7 +446,9 @@ InsertionResult insert_on_either_side(const TetMesh& mesh, std::span<const Trian
                                       const InsertionOptions& options, std::span<const double> resolutions,
                                       bool require_coverage, std::vector<FailedAttempt>& failed) {
   const int count = static_cast<int>(surfaces.size());
-  const std::vector<SideRule> rules(surfaces.size(), options.approximation.side_rule);
+  std::vector<SideRule> rules(surfaces.size(), options.approximation.side_rule);
+  for (int s = 0; s < count; ++s)
+    if (is_closed(surfaces[s])) rules[s] = SideRule::positive_only;  // S_M lies outside a closed S
   auto run = [&](std::span<const SideRule> sides) {
     try {
       return run_stages(mesh, surfaces, options, sides, resolutions, require_coverage);
@@ -601,20 +611,22 @@ double finer_resolution(const MeccanoGrid& meccano, const Clearances& clearance,
 }
 
 // The surfaces as the stages take them: with their rim chords split (surface/rim_chords.hpp), so that
-// S's parameterization is one-to-one whatever the corners.
-std::vector<TriangleSurface> without_rim_chords(std::span<const TriangleSurface> surfaces) {
-  std::vector<TriangleSurface> split;
-  split.reserve(surfaces.size());
-  for (const TriangleSurface& surface : surfaces) split.push_back(split_rim_chords(surface));
-  return split;
+// S's parameterization is one-to-one whatever the corners, and closed ones with their normals pointing
+// out (surface/closed_surface.hpp), so that S_M is built outside them.
+std::vector<TriangleSurface> prepared_for_stages(std::span<const TriangleSurface> surfaces) {
+  std::vector<TriangleSurface> prepared;
+  prepared.reserve(surfaces.size());
+  for (const TriangleSurface& surface : surfaces)
+    prepared.push_back(is_closed(surface) ? oriented_outward(surface) : split_rim_chords(surface));
+  return prepared;
 }
 
 // The insertion at l_r, and where it fails, again with the failing surfaces at a finer l_r.
 InsertionResult insert_surfaces(const TetMesh& mesh, std::span<const TriangleSurface> input_surfaces,
                                 const InsertionOptions& options) {
   const auto pipeline_start = std::chrono::steady_clock::now();
-  const std::vector<TriangleSurface> split_surfaces = without_rim_chords(input_surfaces);
-  const std::span<const TriangleSurface> surfaces(split_surfaces);
+  const std::vector<TriangleSurface> prepared_surfaces = prepared_for_stages(input_surfaces);
+  const std::span<const TriangleSurface> surfaces(prepared_surfaces);
   std::int64_t estimated_tets = mesh.num_tets();
   if (!surfaces.empty()) {
     if (!(options.resolution > 0.0))
@@ -665,6 +677,35 @@ InsertionResult insert_surfaces(const TetMesh& mesh, std::span<const TriangleSur
   }
 }
 
+ProjectionStats SurfaceInsertion::projection_stats() const {
+  if (projections.size() == 1) return projections.front().stats;
+  ProjectionStats combined;
+  std::vector<VertexId> nodes, rim;
+  for (const SurfaceProjection& disk : projections) {
+    const ProjectionStats& p = disk.stats;
+    nodes.insert(nodes.end(), disk.nodes.begin(), disk.nodes.end());
+    for (std::size_t i = 0; i < disk.nodes.size(); ++i)
+      if (disk.on_rim[i]) rim.push_back(disk.nodes[i]);
+    combined.largest_move = std::max(combined.largest_move, p.largest_move);
+    combined.largest_distance_after = std::max(combined.largest_distance_after, p.largest_distance_after);
+    combined.rim_gap = std::max(combined.rim_gap, p.rim_gap);
+    combined.inverted_tets = std::max(combined.inverted_tets, p.inverted_tets);
+    combined.creases.lines += p.creases.lines;
+    combined.creases.crossings += p.creases.crossings;
+    combined.creases.nodes += p.creases.nodes;
+    combined.creases.refused += p.creases.refused;
+    combined.creases.straddling += p.creases.straddling;
+    combined.creases.sharpest = std::max(combined.creases.sharpest, p.creases.sharpest);
+  }
+  for (std::vector<VertexId>* ids : {&nodes, &rim}) {
+    std::ranges::sort(*ids);
+    ids->erase(std::unique(ids->begin(), ids->end()), ids->end());
+  }
+  combined.nodes = static_cast<std::int64_t>(nodes.size());
+  combined.rim_nodes = static_cast<std::int64_t>(rim.size());
+  return combined;
+}
+
 MeshGroups output_groups(const InsertionResult& result, Stage last_stage) {
   MeshGroups groups;
   const MeshGroups standard = standard_groups(result.mesh);
@@ -673,8 +714,9 @@ MeshGroups output_groups(const InsertionResult& result, Stage last_stage) {
     if (group.name.rfind("interface_", 0) != 0) groups.surfaces.push_back(group);  // box sides
   for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s) {
     const SurfaceInsertion& inserted = result.surfaces[s];
-    if (last_stage != Stage::smoothing) {
-      TetGroup volume{"volumetric_" + inserted.name, domain_tag + 1 + s, {}};
+    if (last_stage != Stage::smoothing || inserted.closed) {
+      TetGroup volume{
+          (last_stage != Stage::smoothing ? "volumetric_" : "inside_") + inserted.name, domain_tag + 1 + s, {}};
       for (TetId t = 0; t < result.mesh.num_tets(); ++t)
         if (inserted.volumetric[t]) volume.tets.push_back(t);
       groups.volumes.push_back(std::move(volume));
@@ -806,6 +848,9 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
   if (surfaces.size() != previous.surfaces.size())
     throw InputError(std::to_string(surfaces.size()) + " surfaces to move, but the previous step inserted " +
                      std::to_string(previous.surfaces.size()));
+  for (const TriangleSurface& surface : surfaces)
+    if (is_closed(surface))
+      throw InputError(surface.name + ": moving a closed surface is not supported yet; insert each step anew");
   const ThreadCount threads(options.threads);
   InsertionResult result;
   result.mesh = previous.mesh;
@@ -821,8 +866,8 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
     moved.volumetric = was.volumetric;
     moved.volumetric_stats = was.volumetric_stats;
     moved.healing_stats = was.healing_stats;
-    const SurfaceProjection& from = was.projection;
-    SurfaceProjection& to = moved.projection;
+    const SurfaceProjection& from = was.projections.front();
+    SurfaceProjection& to = moved.projections.emplace_back();
     to.surface = moved_parameterization(*from.surface, split_rim_chords(surfaces[s]));
     to.nodes = from.nodes;
     to.uv = from.uv;
@@ -846,9 +891,10 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
   drag_neighbours(result.mesh, std::move(moved_node), std::move(displacement), move.drag_rings);
   const std::int64_t inverted = count_inverted(result.mesh);
   for (SurfaceInsertion& moved : result.surfaces) {
-    moved.projection.stats.inverted_tets = inverted;
-    report(options, "moved ", moved.name, ": ", moved.projection.nodes.size(), " S_M nodes by up to ",
-           moved.projection.stats.largest_move, "; ", inverted, " tets inverted");
+    SurfaceProjection& projection = moved.projections.front();
+    projection.stats.inverted_tets = inverted;
+    report(options, "moved ", moved.name, ": ", projection.nodes.size(), " S_M nodes by up to ",
+           projection.stats.largest_move, "; ", inverted, " tets inverted");
   }
   result.quality_before_smoothing = summarize_quality(result.mesh);
   // In a band, the improvement (and SUS, if it runs) reaches every node that followed the interface.

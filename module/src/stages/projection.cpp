@@ -3,11 +3,17 @@
 #include <meccano/error.hpp>
 #include <meccano/mesh/quality.hpp>
 #include <meccano/stages/surface_approximation.hpp>
+#include <meccano/surface/closed_surface.hpp>
+#include <meccano/surface/rim_chords.hpp>
+
+#include "mesh/topology_helpers.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
+#include <tuple>
 
 namespace meccano {
 
@@ -126,40 +132,185 @@ void move_nodes_onto_surface(TetMesh& mesh, SurfaceProjection& result, const Tri
   stats.nodes = count;
 }
 
+// One disk of S_M (`triangles`, over the mesh's numbering, oriented like S) onto one disk of S (`target`),
+// with the corners given for both: steps 1-3 once the corners are chosen. `pulled` holds S_M's nodes
+// pulled towards S.
+SurfaceProjection project_disk(TetMesh& mesh, std::span<const std::array<int, 3>> triangles,
+                               const TriangleSurface& target, const std::array<int, 4>& target_corners,
+                               const std::vector<Eigen::Vector3d>& pulled, const std::array<int, 4>& own_corners,
+                               const TriangleBVH& tree, const ProjectionOptions& options) {
+  SurfaceProjection result;
+  result.surface =
+      std::make_unique<ParametricSurface>(target, parameterize_to_square(target, target_corners, options.weights));
+  const SquareParameterization own = parameterize_to_square(DiskView(pulled, triangles), own_corners, options.weights);
+  take_parameters(result, triangles, own, mesh.points.size());
+  result.creases = follow_creases(crease_lines(target, result.surface->parameterization().uv, options.crease_angle),
+                                  result.triangles, result.uv, result.on_rim, result.orientation);
+  result.stats.creases = result.creases.stats;
+  move_nodes_onto_surface(mesh, result, tree);
+  result.stats.rim_nodes = static_cast<std::int64_t>(own.rim.size());
+  return result;
+}
+
+// The triangles of S_M, oriented like S, over the mesh's numbering.
+std::vector<std::array<int, 3>> approximation_triangles(const TetMesh& mesh, const TetRegion& volumetric, int index,
+                                                        int side) {
+  const ApproximationFaces faces = approximation_faces(mesh, volumetric, index, side);
+  return {faces.triangles.begin(), faces.triangles.end()};
+}
+
+// A disk whose interior edges never join two rim vertices: Floater's map of it onto the square is then
+// one-to-one for any four corners, so both halves of a closed surface can share theirs.
+bool is_disk_without_chords(std::span<const std::array<int, 3>> triangles) {
+  detail::TopologyScratch scratch;
+  const detail::TriangleTopology topology = detail::triangle_topology(triangles, scratch);
+  if (topology.components != 1 || topology.overloaded_edges != 0 || topology.pinched_vertices != 0 ||
+      topology.euler() != 1 || detail::count_boundary_loops(scratch) != 1)
+    return false;
+  std::vector<VertexId> rim;
+  for (const detail::Edge& e : scratch.boundary) rim.insert(rim.end(), {e.first, e.second});
+  std::ranges::sort(rim);
+  const auto on_rim = [&](VertexId v) { return std::ranges::binary_search(rim, v); };
+  for (std::size_t i = 0; i + 1 < scratch.edges.size(); ++i) {
+    const detail::Edge& e = scratch.edges[i].first;
+    if (scratch.edges[i + 1].first == e && on_rim(e.first) && on_rim(e.second)) return false;
+  }
+  return true;
+}
+
+// A closed S_M and S cut by one coordinate plane into halves that are disks: [0] below, [1] above.
+struct ClosedCut {
+  int axis = 0;
+  std::array<std::vector<std::array<int, 3>>, 2> approximation;  // S_M's halves, over the mesh's numbering
+  std::array<TriangleSurface, 2> surface;                        // S's halves over one point array
+};
+
+// S_M cut by the computational plane grid[axis] = level: each triangle goes to the side of its
+// centroid. Empty unless every edge between the halves lies in the plane (the cut follows S_M's edges)
+// and each half is a disk without chords.
+std::optional<std::array<std::vector<std::array<int, 3>>, 2>> cut_approximation(
+    const TetMesh& mesh, std::span<const std::array<int, 3>> triangles, int axis, std::int64_t level) {
+  std::array<std::vector<std::array<int, 3>>, 2> halves;
+  for (const auto& t : triangles) {
+    const std::int64_t sum = mesh.grid[t[0]][axis] + mesh.grid[t[1]][axis] + mesh.grid[t[2]][axis];
+    halves[sum >= 3 * level].push_back(t);
+  }
+  if (halves[0].empty() || halves[1].empty()) return std::nullopt;
+  std::vector<std::pair<detail::Edge, int>> edges;
+  for (int half = 0; half < 2; ++half)
+    for (const auto& t : halves[half])
+      for (int k = 0; k < 3; ++k) edges.push_back({detail::make_edge(t[k], t[(k + 1) % 3]), half});
+  std::ranges::sort(edges);
+  for (std::size_t i = 0; i + 1 < edges.size(); ++i)
+    if (edges[i].first == edges[i + 1].first && edges[i].second != edges[i + 1].second &&
+        (mesh.grid[edges[i].first.first][axis] != level || mesh.grid[edges[i].first.second][axis] != level))
+      return std::nullopt;
+  if (!is_disk_without_chords(halves[0]) || !is_disk_without_chords(halves[1])) return std::nullopt;
+  return halves;
+}
+
+// S cut by the physical plane x[axis] = offset into two disks, each with its rim chords split (a vertex
+// of S on the plane can leave one); empty if the plane cuts S in more than one loop, or along a triangle.
+std::optional<std::array<TriangleSurface, 2>> cut_surface(const TriangleSurface& surface, int axis, double offset) {
+  const std::optional<PlaneCut> cut = cut_by_plane(surface, axis, offset);
+  if (!cut) return std::nullopt;
+  std::array<TriangleSurface, 2> halves;
+  for (int half = 0; half < 2; ++half) {
+    TriangleSurface& part = halves[half];
+    part.name = surface.name;
+    part.source = surface.source;
+    part.points = cut->points;
+    part.triangles = half == 0 ? cut->below : cut->above;
+    if (part.triangles.empty()) return std::nullopt;
+    part = split_rim_chords(part);
+    if (!is_disk_without_chords(part.triangles)) return std::nullopt;
+  }
+  return halves;
+}
+
+// The coordinate plane through S_M's nodes nearest to the middle of S_M along some axis that cuts both
+// S_M and S into two disks. Planes are tried by their distance from the middle, as a share of S_M's
+// extent along their axis.
+ClosedCut cut_closed_surface(const TetMesh& mesh, std::span<const std::array<int, 3>> triangles,
+                             const TriangleSurface& surface) {
+  struct Candidate {
+    double off_middle;
+    int axis;
+    std::int64_t level;
+  };
+  std::vector<Candidate> candidates;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<std::int64_t> levels;
+    for (const auto& t : triangles)
+      for (int v : t) levels.push_back(mesh.grid[v][axis]);
+    std::ranges::sort(levels);
+    levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+    if (levels.size() < 3) continue;
+    const double low = static_cast<double>(levels.front()), high = static_cast<double>(levels.back());
+    for (std::size_t i = 1; i + 1 < levels.size(); ++i)
+      candidates.push_back(
+          {std::abs(static_cast<double>(levels[i]) - 0.5 * (low + high)) / (high - low), axis, levels[i]});
+  }
+  std::ranges::sort(candidates, {}, [](const Candidate& c) { return std::tuple(c.off_middle, c.axis, c.level); });
+  for (const Candidate& c : candidates) {
+    auto approximation = cut_approximation(mesh, triangles, c.axis, c.level);
+    if (!approximation) continue;
+    const double offset = mesh.meccano.to_physical(GridPoint{c.level, c.level, c.level})[c.axis];
+    auto halves = cut_surface(surface, c.axis, offset);
+    if (!halves) continue;
+    return {c.axis, std::move(*approximation), std::move(*halves)};
+  }
+  throw MeshingError("no coordinate plane through the nodes of S_M cuts both S_M and the closed surface into two "
+                     "disks (" +
+                     std::to_string(candidates.size()) + " planes tried)");
+}
+
 }  // namespace
 
 SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,
                                        const TriangleSurface& surface, const TriangleBVH& tree,
                                        const ProjectionOptions& options) {
-  // S_M as a disk over the mesh's numbering, oriented like S.
-  const ApproximationFaces faces = approximation_faces(mesh, volumetric, index, side);
-  const std::vector<std::array<int, 3>> triangles(faces.triangles.begin(), faces.triangles.end());
+  const std::vector<std::array<int, 3>> triangles = approximation_triangles(mesh, volumetric, index, side);
   const DiskView target(surface);
   const std::vector<int> surface_rim = rim_loop(target);
-  SurfaceProjection result;
-  result.stats.rim_gap =
-      require_rim_covered(surface, surface_rim, mesh.points, triangles, options.max_rim_gap).distance;
+  const double gap = require_rim_covered(surface, surface_rim, mesh.points, triangles, options.max_rim_gap).distance;
 
   // Matching corners: S's by arc length, S_M's nearest to them around the same mean normal.
   const std::vector<Eigen::Vector3d> pulled = pulled_towards_surface(mesh, triangles, tree);
-  const DiskView approximation(pulled, triangles);
   const auto surface_corners = corners_by_arc_length(target);
   const Eigen::Vector3d normal = vector_area(surface.points, surface_rim);
   std::array<Eigen::Vector3d, 4> targets;
   for (int k = 0; k < 4; ++k) targets[k] = surface.points[surface_corners[k]];
-  const auto approximation_corners = matching_corners(approximation, targets, normal);
+  const auto approximation_corners = matching_corners(DiskView(pulled, triangles), targets, normal);
 
-  result.surface =
-      std::make_unique<ParametricSurface>(target, parameterize_to_square(target, surface_corners, options.weights));
-  const SquareParameterization own = parameterize_to_square(approximation, approximation_corners, options.weights);
-  take_parameters(result, triangles, own, mesh.points.size());
-  result.creases = follow_creases(crease_lines(surface, result.surface->parameterization().uv, options.crease_angle),
-                                  result.triangles, result.uv, result.on_rim, result.orientation);
-  result.stats.creases = result.creases.stats;
-  move_nodes_onto_surface(mesh, result, tree);
-  result.stats.rim_nodes = static_cast<std::int64_t>(own.rim.size());
+  SurfaceProjection result =
+      project_disk(mesh, triangles, surface, surface_corners, pulled, approximation_corners, tree, options);
+  result.stats.rim_gap = gap;
   result.stats.inverted_tets = count_inverted(mesh);
   return result;
+}
+
+std::vector<SurfaceProjection> project_closed_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index,
+                                                           const TriangleSurface& surface, const TriangleBVH& tree,
+                                                           const ProjectionOptions& options) {
+  const std::vector<std::array<int, 3>> triangles = approximation_triangles(mesh, volumetric, index, +1);
+  const ClosedCut cut = cut_closed_surface(mesh, triangles, surface);
+  // Corners on the cut, shared by both halves: S's by arc length along it, S_M's nearest to them.
+  const std::vector<Eigen::Vector3d> pulled = pulled_towards_surface(mesh, triangles, tree);
+  const TriangleSurface& lower = cut.surface[0];
+  const auto surface_corners = corners_by_arc_length(lower);
+  const Eigen::Vector3d normal = vector_area(lower.points, rim_loop(lower));
+  std::array<Eigen::Vector3d, 4> targets;
+  for (int k = 0; k < 4; ++k) targets[k] = lower.points[surface_corners[k]];
+  const auto approximation_corners = matching_corners(DiskView(pulled, cut.approximation[0]), targets, normal);
+
+  std::vector<SurfaceProjection> halves;
+  for (int half = 0; half < 2; ++half)
+    halves.push_back(project_disk(mesh, cut.approximation[half], cut.surface[half], surface_corners, pulled,
+                                  approximation_corners, tree, options));
+  const std::int64_t inverted = count_inverted(mesh);
+  for (SurfaceProjection& half : halves) half.stats.inverted_tets = inverted;
+  return halves;
 }
 
 }  // namespace meccano

@@ -1,4 +1,5 @@
 #include <meccano/stages/surface_approximation.hpp>
+#include <meccano/surface/closed_surface.hpp>
 
 #include <meccano/error.hpp>
 #include <meccano/mesh/bisection.hpp>
@@ -597,11 +598,14 @@ std::int64_t fill_reflex_corners(TetMesh& mesh, const TetRegion& volumetric,
   return filled_now;
 }
 
-// The end of healing when S_M has no defect left to split: an empty string if it is a disk.
-std::string accept_disk(const TetMesh& mesh, const Interface& s, std::size_t reflex_corners_left, HealingStats& stats) {
+// The end of healing when S_M has no defect left to split: an empty string if it is a disk (a sphere
+// for a closed S).
+std::string accept_disk(const TetMesh& mesh, const Interface& s, bool closed, std::size_t reflex_corners_left,
+                        HealingStats& stats) {
   SurfaceApproximationCheck check;
   check_disk(mesh, s, check);
-  if (!check.is_disk()) return "S_M is not a disk: " + check.describe();
+  if (closed && !check.is_sphere()) return "S_M is not a sphere: " + check.describe();
+  if (!closed && !check.is_disk()) return "S_M is not a disk: " + check.describe();
   stats.faces = check.faces;
   stats.rim_nodes = static_cast<std::int64_t>(s.rim_edges.size());
   stats.reflex_corners_left = static_cast<std::int64_t>(reflex_corners_left);
@@ -628,8 +632,8 @@ void split_defects(TetMesh& mesh, const std::vector<TetRegion*>& regions, const 
 
 // One healing attempt on one side; returns an empty string on success, else the reason of failure.
 std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier& sides, FaceTag tag, int side,
-                      const SurfaceApproximationOptions& options, const std::vector<TetRegion*>& other_regions,
-                      HealingStats& stats) {
+                      bool closed, const SurfaceApproximationOptions& options,
+                      const std::vector<TetRegion*>& other_regions, HealingStats& stats) {
   clear_tag(mesh, tag);
   std::vector<std::int8_t> node_side;
   if (std::string failure = tag_faces_on_side(mesh, volumetric, sides, tag, side, node_side, stats); !failure.empty())
@@ -674,7 +678,7 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
              "to them for this resolution)";
     if (doubled.empty() && splits.empty() && defects.cross_surface.empty() && defects.dividing.empty() &&
         defects.chords.empty())
-      return accept_disk(mesh, s, reflex_corners.size(), stats);
+      return accept_disk(mesh, s, closed, reflex_corners.size(), stats);
     split_defects(mesh, regions, doubled, std::move(splits), defects, stats);
   }
   return "healing did not converge in " + std::to_string(options.max_healing_passes) + " passes";
@@ -699,8 +703,9 @@ HealingStats approximate_surface(TetMesh& mesh, TetRegion& volumetric, const Tri
                                  const std::vector<TetRegion*>& other_regions) {
   const FaceTag tag = interface_tag(index);
   const SideClassifier sides(surface, tree);
+  const bool closed = is_closed(surface);
   std::vector<int> sides_to_try;
-  switch (options.side_rule) {
+  switch (closed ? SideRule::positive_only : options.side_rule) {
     case SideRule::positive_first: sides_to_try = {+1, -1}; break;
     case SideRule::negative_first: sides_to_try = {-1, +1}; break;
     case SideRule::positive_only: sides_to_try = {+1}; break;
@@ -711,7 +716,7 @@ HealingStats approximate_surface(TetMesh& mesh, TetRegion& volumetric, const Tri
     HealingStats stats;
     stats.side = side;
     stats.attempts = side == sides_to_try.front() ? 1 : 2;
-    const std::string failure = heal_side(mesh, volumetric, sides, tag, side, options, other_regions, stats);
+    const std::string failure = heal_side(mesh, volumetric, sides, tag, side, closed, options, other_regions, stats);
     if (failure.empty()) {
       stats.first_side_failure = failures;
       return stats;
@@ -719,7 +724,8 @@ HealingStats approximate_surface(TetMesh& mesh, TetRegion& volumetric, const Tri
     failures += (failures.empty() ? "" : "; ") + std::string(side > 0 ? "positive" : "negative") + " side: " + failure;
   }
   clear_tag(mesh, tag);
-  throw MeshingError("the surface approximation S_M could not be healed into a disk (" + failures + ")");
+  throw MeshingError(std::string("the surface approximation S_M could not be healed into a ") +
+                     (closed ? "sphere" : "disk") + " (" + failures + ")");
 }
 
 ApproximationFaces approximation_faces(const TetMesh& mesh, const TetRegion& volumetric, int index, int side) {

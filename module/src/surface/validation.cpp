@@ -1,5 +1,5 @@
 // Topological validation of an immersed surface: it must be a consistently oriented, manifold
-// topological disk. The checks run from the most basic to the most global, so that each one may
+// topological disk, or a closed one of genus 0 (a sphere). The checks run from the most basic to the most global, so that each one may
 // assume what the previous ones established, and the first defect found is reported.
 #include <meccano/error.hpp>
 #include <meccano/surface/validation.hpp>
@@ -231,19 +231,25 @@ void check_manifold_vertices(const TriangleSurface& surface, const std::vector<E
                     " and " + triangle_name(static_cast<std::size_t>(other_triangle)) + " are in different fans)");
 }
 
-void check_disk(const TriangleSurface& surface) {
+// An open surface must be a disk; a closed one a sphere (genus 0), the only closed surfaces supported.
+void check_disk_or_sphere(const TriangleSurface& surface) {
   detail::TopologyScratch scratch;
   const detail::TriangleTopology topology = detail::triangle_topology(surface.triangles, scratch);
+  const std::string euler = "Euler characteristic V - E + F = " + std::to_string(topology.vertices) + " - " +
+                            std::to_string(topology.edges) + " + " + std::to_string(topology.faces) + " = " +
+                            std::to_string(topology.euler());
+  if (topology.boundary_edges == 0) {
+    if (topology.euler() != 2)
+      fail(surface, "closed surface of genus " + std::to_string((2 - topology.euler()) / 2) + " (" + euler +
+                        " instead of 2): only closed surfaces of genus 0 (spheres) are supported");
+    return;
+  }
   const int boundary_loops = detail::count_boundary_loops(scratch);
-  if (topology.boundary_edges == 0)
-    fail(surface, "closed surface (no boundary edges): an open surface with one boundary loop is required");
   if (boundary_loops != 1)
     fail(surface, "not a topological disk: " + std::to_string(boundary_loops) +
                       " boundary loops (the surface has holes); exactly 1 is required");
   if (topology.euler() != 1)
-    fail(surface, "not a topological disk: Euler characteristic V - E + F = " + std::to_string(topology.vertices) +
-                      " - " + std::to_string(topology.edges) + " + " + std::to_string(topology.faces) + " = " +
-                      std::to_string(topology.euler()) + " instead of 1 (the surface has handles)");
+    fail(surface, "not a topological disk: " + euler + " instead of 1 (the surface has handles)");
 }
 
 }  // namespace
@@ -256,7 +262,7 @@ void require_surface_topology(const TriangleSurface& surface) {
   check_consistent_orientation(surface, sides);
   check_single_component(surface);
   check_manifold_vertices(surface, sides);
-  check_disk(surface);
+  check_disk_or_sphere(surface);
 }
 
 }  // namespace meccano

@@ -2,7 +2,8 @@
 // any MSH file (io/msh_reader.hpp), this module's or another mesher's, in floating point (verify_mesh in
 // mesh/invariants.hpp checks a TetMesh exactly, on its computational coordinates).
 //
-// Input   an MshMesh: its tets, and its 2D groups named xmin ... zmax and interface_* if it has them.
+// Input   an MshMesh: its tets, its 2D groups named xmin ... zmax and interface_*, and its 3D groups
+//         named inside_*, if it has them.
 // Checks  conformity   every face of a tet is shared by at most two tets; two tets sharing a face lie on
 //                      its two sides; an unshared face lies on the bounding box of the nodes (else a hole);
 //         orientation  every tet has positive volume (the count of negative and flat ones otherwise);
@@ -11,10 +12,14 @@
 //         box sides    (when groups xmin ... zmax exist) each lies on its box plane, its areas add up to the
 //                      side's area, and the unshared faces of the tets are exactly the box sides' faces;
 //         interface_NAME, one per such group: interior faces only (each shared by two tets), a connected
-//                      manifold disk (Euler characteristic 1, one boundary loop, no pinched vertex),
-//                      consistently oriented. The summary counts the tets with all four nodes on it,
+//                      manifold disk (Euler characteristic 1, one boundary loop, no pinched vertex) or, with
+//                      no boundary edge, a closed one (Euler characteristic 2), consistently oriented. The summary counts the tets with all four nodes on it,
 //                      if any: not a failure, but a fault solver that splits the interface's nodes needs
 //                      none (the module's meshes have none; TetGen's with -Y, coarse, may).
+//         inside_NAME, one per such 3D group (the tets a closed interface_NAME encloses): across every face
+//                      of interface_NAME one tet of the group, behind the face's normal (interfaces point
+//                      out of their inclusions); no other face between the group and the rest of the
+//                      mesh; no tet of the group on the box boundary. The summary gives its volume.
 //         Planes and areas are compared to 1e-9 of the box's largest extent (squared for areas).
 // Output  one CheckResult per check, each with its counts and the first problems, naming the file's
 //         element tags; text() for a terminal, json() for a report.
@@ -29,7 +34,7 @@
 namespace meccano {
 
 struct CheckResult {
-  std::string name;  // "conformity", "orientation", "volume", "box sides", "interface_NAME"
+  std::string name;  // "conformity", "orientation", "volume", "box sides", "interface_NAME", "inside_NAME"
   bool passed = true;
   std::string summary;                // counts or values, one line
   std::vector<std::string> problems;  // the first max_reported defects found

@@ -95,14 +95,19 @@ struct InsertionOptions {
 
 struct SurfaceInsertion {
   std::string name;
+  bool closed = false;      // a closed surface (surface/closed_surface.hpp): V_M is its inside, S_M a sphere
   double resolution = 0.0;  // the l_r it was inserted at: options.resolution, or less after finer retries
   TetRegion volumetric;     // V_M, one flag per tet of the final mesh
   VolumetricStats volumetric_stats;
   double volumetric_seconds = 0.0;
   HealingStats healing_stats;  // of the last healing of this surface's S_M
   double approximation_seconds = 0.0;
-  SurfaceProjection projection;
+  // S_M onto S (stages/projection.hpp): one disk, or the two halves of a closed surface's S_M.
+  std::vector<SurfaceProjection> projections;
   double projection_seconds = 0.0;
+  // The projection's statistics over its disks: counts of distinct nodes (those on a closed surface's cut
+  // once), the largest distances, the rim gap and the inverted tets.
+  ProjectionStats projection_stats() const;
 };
 
 struct InsertionResult {
@@ -150,9 +155,10 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
                               const InsertionOptions& options, const MoveOptions& move = {});
 
 // `domain`, the box sides, and `interface_NAME` for every surface's S_M (once built), oriented like the
-// surface; at the inspection stages (last_stage before smoothing) also `volumetric_NAME` for every
-// surface's V_M. Tags as in io/mesh_writers.hpp: surface k's interface is 7 + k whichever S_M exist, its V_M
-// 2 + k. The final mesh leaves V_M out: formats that write an element once per group (MSH 2.2,
+// surface (out of a closed one); at the inspection stages (last_stage before smoothing) also
+// `volumetric_NAME` for every surface's V_M, and in the final mesh `inside_NAME` for every closed surface:
+// the tets it encloses (its V_M, whose boundary S_M now lies on S). Tags as in io/mesh_writers.hpp: surface
+// k's interface is 7 + k whichever S_M exist, its V_M or inside 2 + k. The final mesh leaves V_M out: formats that write an element once per group (MSH 2.2,
 // VTU) would otherwise hold its tets twice.
 MeshGroups output_groups(const InsertionResult& result, Stage last_stage = Stage::smoothing);
 

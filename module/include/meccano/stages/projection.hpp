@@ -15,6 +15,14 @@
 //          3. Each S_M node's parameters u (φ_M^{-1}(x_M), or its place on a crease) are located in S's
 //             parametric triangulation and the node moves to φ(u). Rim nodes land on the rim of S,
 //             corners on its corners, crease nodes on the crease edges of S.
+// Closed   project_closed_onto_surface, for a closed S (surface/closed_surface.hpp) and its closed S_M (a
+//          sphere, built outside S): both are cut along one coordinate plane into two disks, and each half
+//          of S_M is projected onto its half of S as above. The plane passes through S_M's nodes and
+//          follows its edges (S_M's faces are axis-parallel, so a plane at a node's computational coordinate
+//          usually does); of the planes that leave both S_M and S in two disks without chords (interior
+//          edges between two rim vertices), the one nearest to the middle of S_M is taken. Both halves take
+//          the same corners on the cut and space the nodes between them alike, so a node on the cut lands
+//          on the same point of S from either half. The rim gap is not measured: there is no rim.
 // Output   the moved mesh (tets may be tangled: step 4 untangles them), the parameterizations, and
 //          statistics: how far nodes moved, how far they are from S afterwards, inverted tets.
 // Errors   UncoveredSurfaceError (a MeshingError) if the rim gap exceeds options.max_rim_gap (the message
@@ -34,6 +42,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <vector>
 
 namespace meccano {
 
@@ -91,5 +100,12 @@ bool keeps_orientation(const SurfaceProjection& projection, const std::array<int
 SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,
                                        const TriangleSurface& surface, const TriangleBVH& tree,
                                        const ProjectionOptions& options = {});
+
+// A closed S_M (side +1) onto a closed `surface`: the projections of its two halves, below and above the
+// cut. The nodes on the cut are in both. Throws MeshingError if no coordinate plane cuts both S_M and S
+// into two disks, besides the errors of project_onto_surface.
+std::vector<SurfaceProjection> project_closed_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index,
+                                                           const TriangleSurface& surface, const TriangleBVH& tree,
+                                                           const ProjectionOptions& options = {});
 
 }  // namespace meccano

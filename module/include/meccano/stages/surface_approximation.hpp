@@ -36,9 +36,13 @@
 //          regions follow through the child callback; S_M follows as a face tag.
 // Side     by default +1 (the side S's normals point to) is tried first; if healing fails, the other
 //          side is tried on the mesh as refined so far (SideRule chooses the order or one side only).
+// Closed   a closed S (surface/closed_surface.hpp, its normals pointing out) has V_M enclosing it (its
+//          inside is a cavity of the tets that meet S, which step 1 fills), every boundary node of V_M on
+//          the positive side, and S_M all of V_M's boundary: a sphere. Only the positive side is tried,
+//          whatever the SideRule; the rules about the rim find nothing; the others apply as they are.
 // Output   S_M as the faces tagged interface_tag(k), and the statistics of every rule.
 // Invariants on return (check_surface_approximation): S_M is one connected manifold disk (Euler
-//          characteristic 1, one rim loop, no pinched node), every rim edge is axis-parallel, no corbel,
+//          characteristic 1, one rim loop, no pinched node), or sphere for a closed S (2, no rim), every rim edge is axis-parallel, no corbel,
 //          tet with two faces in S_M, triangle with two rim edges, cross-surface, dividing or chord edge
 //          remains; no S_M node is on the box boundary or on another S_M. Reflex rim corners that
 //          could not be filled are counted, not forbidden.
@@ -122,8 +126,12 @@ struct SurfaceApproximationCheck {
   bool is_disk() const {
     return faces > 0 && connected && non_manifold_edges == 0 && pinched_nodes == 0 && euler == 1 && rim_loops == 1;
   }
+  // What S_M of a closed surface is: V_M encloses S, and S_M is all of V_M's boundary.
+  bool is_sphere() const {
+    return faces > 0 && connected && non_manifold_edges == 0 && pinched_nodes == 0 && euler == 2 && rim_loops == 0;
+  }
   bool healed() const {
-    return is_disk() && oblique_rim_edges == 0 && corbels == 0 && tets_with_two_faces == 0 &&
+    return (is_disk() || is_sphere()) && oblique_rim_edges == 0 && corbels == 0 && tets_with_two_faces == 0 &&
            triangles_with_two_rim_edges == 0 && cross_surface_edges == 0 && dividing_edges == 0 && chord_edges == 0 &&
            nodes_on_box_or_other_surface == 0;
   }

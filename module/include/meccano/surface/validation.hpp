@@ -1,13 +1,14 @@
 // Validation of immersed surfaces before any meshing.
 //
-// The method handles open, simply connected, consistently oriented triangulated surfaces that lie
-// strictly inside the box and do not intersect each other. Every function here throws InputError for
+// The method handles consistently oriented triangulated surfaces that are open disks or closed spheres
+// (genus 0, surface/closed_surface.hpp), lie strictly inside the box and do not intersect each other. Every function here throws InputError for
 // the first defect it finds; the message names the surface's source file (or its name), the element
 // (1-based triangle or vertex number, in the order read) and the defect.
 //
 // Topology (surface/validation.cpp): empty surface, non-finite coordinates, index out of range,
 // zero-area triangle, non-manifold edge or vertex, inconsistent orientation, more than one connected
-// component, not a topological disk (closed, with holes, annulus, ...).
+// component, neither a topological disk (holes, an annulus, a handle) nor a sphere (a closed surface of
+// genus 1 or more: a torus).
 // Geometry (surface/geometry_checks.cpp): self-intersection, a point outside or on the box boundary,
 // two surfaces that intersect or touch.
 #pragma once

@@ -1,0 +1,93 @@
+#include <meccano/surface/closed_surface.hpp>
+
+#include "mesh/topology_helpers.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace meccano {
+
+bool is_closed(const TriangleSurface& surface) {
+  const auto edges = detail::edges_with_triangles(surface.triangles);
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const bool shared = (i + 1 < edges.size() && edges[i + 1].first == edges[i].first) ||
+                        (i > 0 && edges[i - 1].first == edges[i].first);
+    if (!shared) return false;
+  }
+  return !edges.empty();
+}
+
+double enclosed_volume(const TriangleSurface& surface) {
+  // The divergence theorem over the tets joining each triangle to a point of S (its first point), which
+  // keeps the terms small far from the origin (UTM coordinates).
+  if (surface.points.empty()) return 0.0;
+  const Eigen::Vector3d origin = surface.points.front();
+  double six_volumes = 0.0;
+  for (const auto& t : surface.triangles)
+    six_volumes +=
+        (surface.points[t[0]] - origin).dot((surface.points[t[1]] - origin).cross(surface.points[t[2]] - origin));
+  return six_volumes / 6.0;
+}
+
+TriangleSurface oriented_outward(TriangleSurface surface) {
+  if (enclosed_volume(surface) < 0.0)
+    for (auto& t : surface.triangles) std::swap(t[1], t[2]);
+  return surface;
+}
+
+std::optional<PlaneCut> cut_by_plane(const TriangleSurface& surface, int axis, double offset) {
+  PlaneCut cut;
+  cut.points = surface.points;
+  std::vector<double> height(cut.points.size());
+  for (std::size_t v = 0; v < height.size(); ++v) height[v] = cut.points[v][axis] - offset;
+  // Vertices nearly on the plane, seen from an edge that crosses it, count as on it (where they are: S
+  // keeps its geometry): a crossing there would leave a sliver.
+  for (const auto& t : surface.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (height[a] * height[b] >= 0.0) continue;
+      const double span = std::abs(height[a] - height[b]);
+      for (int v : {a, b})
+        if (std::abs(height[v]) < cut_snap * span) height[v] = 0.0;
+    }
+
+  std::map<detail::Edge, int> crossing_of;  // ordered: the crossings' ids do not depend on hashing
+  auto crossing = [&](int a, int b) {
+    const auto [it, added] = crossing_of.try_emplace(detail::make_edge(a, b), static_cast<int>(cut.points.size()));
+    if (added) {
+      const int low = it->first.first, high = it->first.second;  // the same point from either triangle
+      const double s = height[low] / (height[low] - height[high]);
+      cut.points.push_back(cut.points[low] + s * (cut.points[high] - cut.points[low]));
+    }
+    return it->second;
+  };
+  for (const auto& t : surface.triangles) {
+    std::array<int, 3> sign{};
+    for (int k = 0; k < 3; ++k) sign[k] = (height[t[k]] > 0.0) - (height[t[k]] < 0.0);
+    if (sign[0] == 0 && sign[1] == 0 && sign[2] == 0) return std::nullopt;
+    // The triangle's polygon on each side: its vertices there (those on the plane on both), and the
+    // crossings of its edges, in the triangle's own order; each is convex, so a fan triangulates it.
+    std::array<std::vector<int>, 2> polygon;  // below, above
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (sign[k] <= 0) polygon[0].push_back(a);
+      if (sign[k] >= 0) polygon[1].push_back(a);
+      if (sign[k] * sign[(k + 1) % 3] < 0) {
+        const int x = crossing(a, b);
+        polygon[0].push_back(x);
+        polygon[1].push_back(x);
+      }
+    }
+    for (int side = 0; side < 2; ++side) {
+      const std::vector<int>& p = polygon[side];
+      auto& part = side == 0 ? cut.below : cut.above;
+      for (std::size_t k = 2; k < p.size(); ++k) part.push_back({p[0], p[k - 1], p[k]});
+    }
+  }
+  return cut;
+}
+
+}  // namespace meccano

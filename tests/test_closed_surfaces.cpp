@@ -140,19 +140,28 @@ TEST(ClosedSurface, ABumpyBlobAtTwoResolutions) {
   }
 }
 
+// The fault comes first, so the inclusions' S_M halves are not at their surfaces' indices among the
+// projections the improvement stage takes.
 TEST(ClosedSurface, TwoInclusionsAndAFaultBesideThem) {
   std::vector<TriangleSurface> surfaces{
-      testing::ellipsoid({0.28, 0.5, 0.5}, {0.15, 0.15, 0.15}, 10, "left"),
-      testing::ellipsoid({0.72, 0.5, 0.5}, {0.15, 0.2, 0.15}, 10, "right"),
       testing::graph_patch([](double x, double) { return 0.82 + 0.05 * std::sin(6 * x); }, {0.15, 0.85}, {0.15, 0.85},
-                           12, "fault")};
+                           12, "fault"),
+      testing::ellipsoid({0.28, 0.5, 0.5}, {0.15, 0.15, 0.15}, 10, "left"),
+      testing::ellipsoid({0.72, 0.5, 0.5}, {0.15, 0.2, 0.15}, 10, "right")};
   const InsertionResult result = insert(surfaces, kUnitBox, 0.05);
+  EXPECT_FALSE(result.surfaces[0].closed);
   // Faces up to l_r long on spheres of radius 0.15 cut off more of them: 1.3 % measured.
-  expect_closed_interface(result, surfaces[0], 0, 0.03);
   expect_closed_interface(result, surfaces[1], 1, 0.03);
-  EXPECT_FALSE(result.surfaces[2].closed);
+  expect_closed_interface(result, surfaces[2], 2, 0.03);
   const MeshGroups groups = output_groups(result);
   EXPECT_EQ(std::ranges::count_if(groups.volumes, [](const TetGroup& g) { return g.name.starts_with("inside_"); }), 2);
+}
+
+// An inclusion 0.1 thick at l_r = 0.07: the improvement's edge flips inside S_M must find the half of
+// S_M that holds an edge (they once looked in the other and failed).
+TEST(ClosedSurface, AThinEllipsoidAtACoarseResolution) {
+  const TriangleSurface surface = testing::ellipsoid({0.5, 0.5, 0.5}, {0.35, 0.3, 0.05}, 16);
+  expect_closed_interface(insert({&surface, 1}, kUnitBox, 0.07), surface, 0, 0.1);
 }
 
 // `meccano-immerse check` on the written file: the closed interface and its inside pass; an inside group

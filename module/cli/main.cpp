@@ -54,7 +54,8 @@ Options:
                            1.26·h·2^(-K/3) on average (the longest √3·h/2^k at K = 3k), h the cell edge
                            (by default about the box's shortest extent). A solver's accuracy away from
                            the surfaces depends on K: the default leaves 6 tets per cell there
-  --surface FILE[:NAME]    an open triangulated surface strictly inside the box (.obj, .stl, .off,
+  --surface FILE[:NAME]    a triangulated surface strictly inside the box, open (a disk) or closed (a
+                           sphere: its inside becomes the 3D group inside_NAME) (.obj, .stl, .off,
                            .msh, .ts GOCAD TSurf); NAME defaults to its 1-based position (may repeat).
                            Coordinates are taken as in the file: a TSurf's z is its own (a ZPOSITIVE
                            Depth file keeps its positive depths), so give the box in the same terms
@@ -154,8 +155,8 @@ below what the insertions gave. --from-scratch inserts every step anew.
 
 check FILE.msh checks the invariants of a tet mesh of a box in any Gmsh MSH file (2.2 or 4.1, ASCII or
 binary; this tool's, Gmsh's, ...): conformity, orientation, volume, the box sides xmin ... zmax (if the
-file has those groups) and every interface_* group (interior faces forming a consistently oriented
-disk). It prints one line per check (--quiet: nothing), writes them as JSON with --report, and exits 0
+file has those groups), every interface_* group (interior faces forming a consistently oriented disk,
+or a closed surface of Euler characteristic 2) and every inside_* group (bounded by its interface). It prints one line per check (--quiet: nothing), writes them as JSON with --report, and exits 0
 if every check passes, 1 if one fails or the file cannot be read.
 
 measure FILE.msh measures a tet mesh in any Gmsh MSH file the same way whatever made it (this tool,

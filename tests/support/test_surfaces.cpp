@@ -177,12 +177,12 @@ TriangleSurface octahedral_sphere(const std::function<Vector3d(const Vector3d&)>
   };
   for (int face = 0; face < 8; ++face) {
     const std::array<int, 3> sign{face & 1 ? -1 : 1, face & 2 ? -1 : 1, face & 4 ? -1 : 1};
-    auto at = [&](int a, int b) { return point({sign[0] * a, sign[1] * b, sign[2] * (n - a - b)}); };
-    auto add = [&](int p, int q, int r) {
-      // Out of the octahedron: along the face's normal (sign).
-      const Vector3d normal = (surface.points[q] - surface.points[p]).cross(surface.points[r] - surface.points[p]);
-      if (normal.dot(Vector3d(sign[0], sign[1], sign[2])) < 0) std::swap(q, r);
-      surface.triangles.push_back({p, q, r});
+    auto at = [&](int a, int b) { return std::array<int, 3>{sign[0] * a, sign[1] * b, sign[2] * (n - a - b)}; };
+    auto add = [&](std::array<int, 3> p, std::array<int, 3> q, std::array<int, 3> r) {
+      // Out of the octahedron, decided on the octahedron itself (along the face's normal, `sign`).
+      const Vector3d u(q[0] - p[0], q[1] - p[1], q[2] - p[2]), v(r[0] - p[0], r[1] - p[1], r[2] - p[2]);
+      if (u.cross(v).dot(Vector3d(sign[0], sign[1], sign[2])) < 0) std::swap(q, r);
+      surface.triangles.push_back({point(p), point(q), point(r)});
     };
     for (int a = 0; a < n; ++a)
       for (int b = 0; a + b < n; ++b) {

@@ -76,12 +76,24 @@ class Flipper {
         regions_(regions),
         options_(options),
         surface_of_(mesh.points.size(), -1),
+        projection_of_(mesh.points.size(), -1),
         node_index_(mesh.points.size(), -1) {
-    for (std::size_t s = 0; s < surfaces.size(); ++s)
-      for (std::size_t i = 0; i < surfaces[s]->nodes.size(); ++i) {
-        surface_of_[surfaces[s]->nodes[i]] = static_cast<int>(s);
-        node_index_[surfaces[s]->nodes[i]] = static_cast<int>(i);
+    for (int s = 0; s < static_cast<int>(surfaces.size()); ++s)
+      for (int i = 0; i < static_cast<int>(surfaces[s]->nodes.size()); ++i) {
+        const VertexId v = surfaces[s]->nodes[i];
+        surface_of_[v] = surfaces[s]->surface_index;
+        if (projection_of_[v] >= 0) {  // on the cut of a closed surface: in both halves
+          shared_index_.emplace(std::pair{projection_of_[v], v}, node_index_[v]);
+          shared_index_.emplace(std::pair{s, v}, i);
+          projection_of_[v] = shared_node;
+        } else if (projection_of_[v] == shared_node) {
+          shared_index_.emplace(std::pair{s, v}, i);
+        } else {
+          projection_of_[v] = s;
+          node_index_[v] = i;
+        }
       }
+    for (int s = 0; s < static_cast<int>(surfaces.size()); ++s) triangle_index(s);
     for (const TetRegion* region : regions)
       if (region->size() != mesh.tets.size())
         throw std::invalid_argument("flip_worst_tets: a region's size is not the tet count");
@@ -99,7 +111,6 @@ class Flipper {
     for (TetId t = 0; t < mesh_.num_tets(); ++t)
       for (VertexId v : mesh_.tets[t]) incident_[v] = t;
     for (int s = 0; s < static_cast<int>(surfaces_.size()); ++s) {
-      triangle_index(s);
       for (int pass = 0; pass < max_crease_passes; ++pass) {
         const SurfaceProjection& projection = *surfaces_[s];
         std::vector<int> touched;  // nodes of the edges mended in this pass: their other crossings wait
@@ -312,8 +323,8 @@ class Flipper {
     const Eigen::Vector2d &ua = projection.uv[crossing.a], &ub = projection.uv[crossing.b];
     double before = 1.0, after = 1.0;
     for (VertexId x : apexes) {
-      const Eigen::Vector2d& ux = projection.uv[node_index_[x]];
-      before = std::min(before, triangle_alignment(s, {crossing.a, crossing.b, node_index_[x]}));
+      const Eigen::Vector2d& ux = projection.uv[node_index(s, x)];
+      before = std::min(before, triangle_alignment(s, {crossing.a, crossing.b, node_index(s, x)}));
       after = std::min({after, alignment(s, {xa, m, mesh_.points[x]}, (ua + crossing.at + ux) / 3.0),
                         alignment(s, {m, xb, mesh_.points[x]}, (crossing.at + ub + ux) / 3.0)});
     }
@@ -328,10 +339,12 @@ class Flipper {
     for (TetId t : star)
       for (int f = 0; f < 4; ++f) {
         const Tet& tet = mesh_.tets[t];
-        if (tet[f] == v || mesh_.face_tags[t][f] != interface_tag(s)) continue;
+        if (tet[f] == v || mesh_.face_tags[t][f] != tag_of(s)) continue;
         std::array<int, 3> nodes;
-        for (int k = 0; k < 3; ++k) nodes[k] = node_index_[tet[face_vertices[f][k]]];
-        const std::array<int, 3>& triangle = projection.triangles[index.at(sorted_triangle(nodes))];
+        for (int k = 0; k < 3; ++k) nodes[k] = node_index(s, tet[face_vertices[f][k]]);
+        const auto held = index.find(sorted_triangle(nodes));
+        if (held == index.end()) continue;  // a triangle of the other half of a closed S_M
+        const std::array<int, 3>& triangle = projection.triangles[held->second];
         if (std::ranges::find(triangles, triangle) == triangles.end()) triangles.push_back(triangle);
       }
     return triangles;
@@ -350,7 +363,8 @@ class Flipper {
     for (int k = 0; k < 3; ++k)
       grid[k] = mesh_.grid[a][k] + std::llround(crossing.r * static_cast<double>(mesh_.grid[b][k] - mesh_.grid[a][k]));
     const VertexId m = mesh_.add_vertex(point, grid);
-    surface_of_.push_back(s);
+    surface_of_.push_back(projection.surface_index);
+    projection_of_.push_back(s);
     node_index_.push_back(static_cast<int>(projection.nodes.size()));
     incident_.push_back(no_tet);
 
@@ -372,7 +386,7 @@ class Flipper {
         const VertexId opposite = mesh_.tets[t][f];
         const FaceTag tag = mesh_.face_tags[t][f];
         if (opposite == a || opposite == b || tag == no_face_tag) continue;
-        if (mesh_.neighbours[t][f] == no_tet || tag != interface_tag(s)) return std::nullopt;
+        if (mesh_.neighbours[t][f] == no_tet || tag != tag_of(s)) return std::nullopt;
         VertexId x = no_tet;
         for (VertexId v : mesh_.tets[t])
           if (v != a && v != b && v != opposite) x = v;
@@ -391,6 +405,7 @@ class Flipper {
     mesh_.points.resize(count);
     mesh_.grid.resize(count);
     surface_of_.resize(count);
+    projection_of_.resize(count);
     node_index_.resize(count);
     incident_.resize(count);
   }
@@ -407,7 +422,7 @@ class Flipper {
     projection.creases.parameter.push_back(crossing.s);
     auto& index = triangle_index(s);
     for (VertexId x : apexes) {
-      const int apex = node_index_[x];
+      const int apex = node_index(s, x);
       const auto old = index.find(sorted_triangle({crossing.a, crossing.b, apex}));
       if (old == index.end()) throw MeshingError("a crease split did not find S_M's triangle");
       const int t = old->second;
@@ -598,7 +613,7 @@ class Flipper {
     if (!(r.worst_created > std::min(r.worst_removed, floor))) return std::nullopt;
     if (q != 0) {
       const FaceTag interface = around->interface;
-      r.surface_flip = interface_flip(interface_index(interface), a, b, ring[0], ring[q]);
+      r.surface_flip = interface_flip(interface, a, b, ring[0], ring[q]);
       if (!r.surface_flip) return std::nullopt;
       r.tagged_faces = {{sorted_face({a, ring[0], ring[q], b}, 3), interface},
                         {sorted_face({b, ring[0], ring[q], a}, 3), interface}};
@@ -611,9 +626,13 @@ class Flipper {
   // diagonal must cross (a, b) in P (so S_M stays embedded in P, as step 4 keeps it), and the new
   // triangles' normals may deviate from S's (at their centroids in P) no more than the old ones' do.
   // Returns the new triangles as node indices of the surface, oriented like S in P.
-  std::optional<SurfaceFlip> interface_flip(int surface, VertexId a, VertexId b, VertexId p, VertexId q) const {
+  // Nothing if no projection of that interface holds both triangles (an edge on a closed S_M's cut).
+  std::optional<SurfaceFlip> interface_flip(FaceTag interface, VertexId a, VertexId b, VertexId p, VertexId q) const {
+    const int surface = projection_holding(interface, a, b, p, q);
+    if (surface < 0) return std::nullopt;
     const SurfaceProjection& projection = *surfaces_[surface];
-    const int na = node_index_[a], nb = node_index_[b], np = node_index_[p], nq = node_index_[q];
+    const int na = node_index(surface, a), nb = node_index(surface, b), np = node_index(surface, p),
+              nq = node_index(surface, q);
     auto uv = [&](int node) { return projection.uv[node]; };
     auto orient = [&](int x, int y, int z) { return cross2(uv(y) - uv(x), uv(z) - uv(x)); };
     if (!(orient(np, nq, na) * orient(np, nq, nb) < 0.0) || !(orient(na, nb, np) * orient(na, nb, nq) < 0.0))
@@ -649,6 +668,28 @@ class Flipper {
     }
     return alignment(s, x, centroid);
   }
+
+  // The projection of the S_M tagged `interface` whose triangles include (a, b, p) and (a, b, q), or -1.
+  int projection_holding(FaceTag interface, VertexId a, VertexId b, VertexId p, VertexId q) const {
+    for (int s = 0; s < static_cast<int>(surfaces_.size()); ++s) {
+      if (tag_of(s) != interface) continue;
+      const int na = node_index(s, a), nb = node_index(s, b), np = node_index(s, p), nq = node_index(s, q);
+      if (na < 0 || nb < 0 || np < 0 || nq < 0) continue;
+      const auto& index = triangle_of_[s];
+      if (index.contains(sorted_triangle({na, nb, np})) && index.contains(sorted_triangle({na, nb, nq}))) return s;
+    }
+    return -1;
+  }
+
+  // Vertex v's index in the nodes of projection s, or -1 if it is not one of them.
+  int node_index(int s, VertexId v) const {
+    if (projection_of_[v] == s) return node_index_[v];
+    if (projection_of_[v] != shared_node) return -1;
+    const auto found = shared_index_.find({s, v});
+    return found == shared_index_.end() ? -1 : found->second;
+  }
+
+  FaceTag tag_of(int s) const { return interface_tag(surfaces_[s]->surface_index); }
 
   static std::array<int, 3> sorted_triangle(std::array<int, 3> triangle) {
     std::sort(triangle.begin(), triangle.end());
@@ -835,8 +876,13 @@ class Flipper {
   std::span<SurfaceProjection* const> surfaces_;
   std::span<TetRegion* const> regions_;  // per-tet flags that follow the flips
   const ImprovementOptions& options_;
-  std::vector<int> surface_of_;  // the surface whose S_M holds each vertex, or -1
-  std::vector<int> node_index_;  // each S_M vertex's index in its surface's nodes, or -1
+  // The surfaces_ are projections: one per S_M, or two for a closed one (stages/projection.hpp), whose
+  // nodes on the cut are in both.
+  static constexpr int shared_node = -2;
+  std::vector<int> surface_of_;     // the surface (interface index) whose S_M holds each vertex, or -1
+  std::vector<int> projection_of_;  // the projection holding each vertex, -1, or shared_node
+  std::vector<int> node_index_;     // each vertex's index in projection_of_'s nodes, or -1
+  std::map<std::pair<int, VertexId>, int> shared_index_;  // (projection, shared vertex) -> its index there
   // Per surface, S_M's triangles by their sorted node indices (triangle_index).
   std::vector<std::map<std::array<int, 3>, int>> triangle_of_;
   std::vector<TetId> incident_;  // while mending creases: a tet holding each vertex

@@ -868,6 +868,7 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
     moved.healing_stats = was.healing_stats;
     const SurfaceProjection& from = was.projections.front();
     SurfaceProjection& to = moved.projections.emplace_back();
+    to.surface_index = from.surface_index;
     to.surface = moved_parameterization(*from.surface, split_rim_chords(surfaces[s]));
     to.nodes = from.nodes;
     to.uv = from.uv;

@@ -285,6 +285,7 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
 
   SurfaceProjection result =
       project_disk(mesh, triangles, surface, surface_corners, pulled, approximation_corners, tree, options);
+  result.surface_index = index;
   result.stats.rim_gap = gap;
   result.stats.inverted_tets = count_inverted(mesh);
   return result;
@@ -309,7 +310,10 @@ std::vector<SurfaceProjection> project_closed_onto_surface(TetMesh& mesh, const 
     halves.push_back(project_disk(mesh, cut.approximation[half], cut.surface[half], surface_corners, pulled,
                                   approximation_corners, tree, options));
   const std::int64_t inverted = count_inverted(mesh);
-  for (SurfaceProjection& half : halves) half.stats.inverted_tets = inverted;
+  for (SurfaceProjection& half : halves) {
+    half.surface_index = index;
+    half.stats.inverted_tets = inverted;
+  }
   return halves;
 }
 

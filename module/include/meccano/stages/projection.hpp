@@ -81,6 +81,7 @@ RimGap rim_gap(std::span<const Eigen::Vector3d> surface_points, std::span<const 
 
 // What step 4 needs to move S_M nodes within S: φ, and each S_M node's parameters.
 struct SurfaceProjection {
+  int surface_index = -1;  // the surface whose S_M this is: its faces are interface_tag(surface_index)
   std::unique_ptr<ParametricSurface> surface;  // φ: P -> S
   std::vector<VertexId> nodes;                 // the S_M nodes
   std::vector<Eigen::Vector2d> uv;             // their parameters (same order)

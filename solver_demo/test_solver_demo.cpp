@@ -326,6 +326,33 @@ std::map<std::vector<Corner>, dealii::Tensor<1, 3>> expect_triangulation_of(cons
 
 // The module's mesh as a serial triangulation; the normals are those of the module's own interface
 // faces (surface_interfaces), S's normals.
+// An inclusion's tets carry the material id of inside_NAME (2 for the first surface), in process and
+// through the file, and the closed interface is there with its normals out.
+TEST_F(AdapterTest, AnInclusionsCellsHaveItsMaterialId) {
+  meccano::TriangleSurface sphere = meccano::testing::sphere(8);
+  sphere.name = "ball";
+  const meccano::InsertionResult result = insert(sphere, 3, 0.1);
+  const auto count_inside = [](const meccano::DealiiMesh& mesh) {
+    return std::count_if(mesh.cells.begin(), mesh.cells.end(),
+                         [](const dealii::CellData<3>& cell) { return cell.material_id == meccano::domain_tag + 1; });
+  };
+  const meccano::DealiiMesh direct = meccano::dealii_mesh(result);
+  const auto inside = std::count(result.surfaces[0].volumetric.begin(), result.surfaces[0].volumetric.end(), 1);
+  ASSERT_GT(inside, 0);
+  EXPECT_EQ(count_inside(direct), inside);
+  meccano::write_msh41(result.mesh, meccano::output_groups(result), path("ball.msh"));
+  const meccano::DealiiMesh read = meccano::read_dealii_mesh(path("ball.msh"));
+  EXPECT_EQ(count_inside(read), inside);
+  // Every interface normal points away from the centre.
+  const meccano::DealiiInterface& ball = read.interface("ball");
+  for (std::size_t t = 0; t < ball.triangles(); ++t) {
+    const dealii::Point<3>& a = ball.corners[3 * t];
+    const dealii::Tensor<1, 3> normal =
+        dealii::cross_product_3d(ball.corners[3 * t + 1] - a, ball.corners[3 * t + 2] - a);
+    EXPECT_GT(normal * (a - dealii::Point<3>(0.5, 0.5, 0.5)), 0.0) << "triangle " << t;
+  }
+}
+
 TEST_F(AdapterTest, SerialTriangulationHasSideIdsAndInterfaceFaces) {
   const meccano::InsertionResult result = insert(triangulate_cube_example(24), 9, 0.1);
   const meccano::DealiiMesh mesh = meccano::dealii_mesh(result);

@@ -120,6 +120,11 @@ DealiiMesh dealii_mesh(const InsertionResult& result) {
             face_data({unsigned(face[0]), unsigned(face[1]), unsigned(face[2])}, tets.face_tags[t][f]));
       }
   }
+  // The tets a closed surface encloses (its V_M) take the tag of inside_NAME.
+  for (int s = 0; s < static_cast<int>(result.surfaces.size()); ++s)
+    if (result.surfaces[s].closed)
+      for (TetId t = 0; t < tets.num_tets(); ++t)
+        if (result.surfaces[s].volumetric[t]) mesh.cells[t].material_id = domain_tag + 1 + s;
   for (const SurfaceInterface& surface : surface_interfaces(result)) {
     DealiiInterface& interface = mesh.interfaces.emplace_back();
     interface.name = surface.name;
@@ -159,6 +164,10 @@ DealiiMesh read_dealii_mesh(const std::string& msh_path) {
     if (volume6 < 0.0) std::swap(v[2], v[3]);
     mesh.cells[t].material_id = domain_tag;
   }
+
+  for (const MshGroup& group : file.groups)
+    if (group.dimension == 3 && group.name.rfind("inside_", 0) == 0)
+      for (const int t : group.elements) mesh.cells[t].material_id = static_cast<dealii::types::material_id>(group.tag);
 
   const MshFaces faces(file, vertex_of_node, mesh);
   for (const MshGroup& group : file.groups) {

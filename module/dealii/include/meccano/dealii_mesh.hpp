@@ -8,8 +8,10 @@
 //
 // Input    an InsertionResult (dealii_mesh), or an MSH file (read_dealii_mesh: 2.2 or 4.1, ASCII or
 //          binary, this module's, reference-gmsh's, reference-tetgen's, Gmsh's) with the groups `xmin` ...
-//          `zmax` and `interface_NAME` (doc/user_guide.md, "Tags"); other groups are ignored.
-// Output   DealiiMesh: vertices; positively oriented tets (material id = domain_tag); the box-side faces
+//          `zmax`, `interface_NAME` and `inside_NAME` (doc/user_guide.md, "Tags"); other groups are ignored.
+// Output   DealiiMesh: vertices; positively oriented tets (material id = domain_tag, or the tag of
+//          `inside_NAME`, 2 + k, for the tets a closed surface k encloses: an inclusion's coefficient can
+//          be set by material id); the box-side faces
 //          with boundary id = their side's tag 1-6 (other boundary faces keep 0); S's faces with
 //          boundary id numbers::internal_face_boundary_id and manifold id = S's tag; per surface its
 //          triangles as corner points, oriented like S.

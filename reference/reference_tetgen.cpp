@@ -53,8 +53,10 @@ triangle: the interface is the input surface itself.
 Options:
   --box XMIN YMIN ZMIN XMAX YMAX ZMAX  the box (required); the comma form of meccano-immerse,
                            --box X0,Y0,Z0,X1,Y1,Z1, is accepted too
-  --surface FILE[:NAME]    an open triangulated surface strictly inside the box (.obj, .stl, .off,
-                           .msh); NAME defaults to its 1-based position (may repeat; at least one)
+  --surface FILE[:NAME]    a triangulated surface strictly inside the box, open or closed (a closed
+                           one's inside is meshed too, but written in domain only: no inside_NAME)
+                           (.obj, .stl, .off, .msh); NAME defaults to its 1-based position (may
+                           repeat; at least one)
   --size H                 mesh size (required): every tet's volume is bounded by that of the regular
                            tet of edge H, H^3 / (6 sqrt 2) (TetGen's -a). That bounds every tet, where
                            Gmsh's size is an edge length to aim at, so TetGen makes about 4 times more

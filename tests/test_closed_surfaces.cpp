@@ -10,6 +10,7 @@
 #include <meccano/mesh/invariants.hpp>
 #include <meccano/mesh/quality.hpp>
 #include <meccano/stages/pipeline.hpp>
+#include <meccano/stages/sequence.hpp>
 #include <meccano/surface/closed_surface.hpp>
 #include <meccano/surface/validation.hpp>
 
@@ -226,6 +227,23 @@ TEST(ClosedSurface, MovingOneIsRefusedWithAReason) {
     FAIL() << "a closed surface was moved";
   } catch (const InputError& error) {
     EXPECT_THAT(error.what(), HasSubstr("moving a closed surface is not supported"));
+  }
+}
+
+// A sequence inserts each step of a closed surface anew, says why, and every step is a valid inclusion.
+TEST(ClosedSurface, ASequenceInsertsEachStepAnew) {
+  InsertionOptions options;
+  options.resolution = 0.1;
+  SurfaceSequence sequence(make_cube_meccano(kUnitBox, 0), options);
+  TriangleSurface surface = testing::sphere(8);
+  for (int step = 0; step < 2; ++step) {
+    const SequenceStep& done = sequence.advance({surface});
+    EXPECT_EQ(done.kind, StepKind::inserted);
+    if (step > 0) {
+      EXPECT_THAT(done.inserted_because, HasSubstr("sphere is closed"));
+    }
+    expect_closed_interface(done.result, surface, 0, 0.05);
+    for (Eigen::Vector3d& p : surface.points) p.z() += 0.02;
   }
 }
 

@@ -180,7 +180,6 @@ bool is_disk_without_chords(std::span<const std::array<int, 3>> triangles) {
 
 // A closed S_M and S cut by one coordinate plane into halves that are disks: [0] below, [1] above.
 struct ClosedCut {
-  int axis = 0;
   std::array<std::vector<std::array<int, 3>>, 2> approximation;  // S_M's halves, over the mesh's numbering
   std::array<TriangleSurface, 2> surface;                        // S's halves over one point array
 };
@@ -258,7 +257,7 @@ ClosedCut cut_closed_surface(const TetMesh& mesh, std::span<const std::array<int
     const double offset = mesh.meccano.to_physical(GridPoint{c.level, c.level, c.level})[c.axis];
     auto halves = cut_surface(surface, c.axis, offset);
     if (!halves) continue;
-    return {c.axis, std::move(*approximation), std::move(*halves)};
+    return {std::move(*approximation), std::move(*halves)};
   }
   throw MeshingError("no coordinate plane through the nodes of S_M cuts both S_M and the closed surface into two "
                      "disks (" +

@@ -11,13 +11,8 @@
 namespace meccano {
 
 bool is_closed(const TriangleSurface& surface) {
-  const auto edges = detail::edges_with_triangles(surface.triangles);
-  for (std::size_t i = 0; i < edges.size(); ++i) {
-    const bool shared = (i + 1 < edges.size() && edges[i + 1].first == edges[i].first) ||
-                        (i > 0 && edges[i - 1].first == edges[i].first);
-    if (!shared) return false;
-  }
-  return !edges.empty();
+  detail::TopologyScratch scratch;
+  return !surface.triangles.empty() && detail::triangle_topology(surface.triangles, scratch).boundary_edges == 0;
 }
 
 double enclosed_volume(const TriangleSurface& surface) {

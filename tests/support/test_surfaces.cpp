@@ -1,6 +1,7 @@
 #include "test_surfaces.hpp"
 
 #include <meccano/io/surface_readers.hpp>
+#include <meccano/surface/closed_surface.hpp>
 
 #include <Eigen/Geometry>
 
@@ -162,42 +163,9 @@ TriangleSurface paper_like_patch(int n) {
       {0.2, 0.8}, {0.2, 0.8}, n, "paper_like");
 }
 
-namespace {
-
-// The octahedron |x| + |y| + |z| = 1, each face cut into n^2 triangles, its points mapped by `place` (a
-// function of the unit direction), normals pointing out.
-TriangleSurface octahedral_sphere(const std::function<Vector3d(const Vector3d&)>& place, int n, std::string name) {
-  TriangleSurface surface;
-  surface.name = std::move(name);
-  std::map<std::array<int, 3>, int> index;  // integer point on the octahedron, times n
-  auto point = [&](const std::array<int, 3>& q) {
-    const auto [it, added] = index.try_emplace(q, static_cast<int>(surface.points.size()));
-    if (added) surface.points.push_back(place(Vector3d(q[0], q[1], q[2]).normalized()));
-    return it->second;
-  };
-  for (int face = 0; face < 8; ++face) {
-    const std::array<int, 3> sign{face & 1 ? -1 : 1, face & 2 ? -1 : 1, face & 4 ? -1 : 1};
-    auto at = [&](int a, int b) { return std::array<int, 3>{sign[0] * a, sign[1] * b, sign[2] * (n - a - b)}; };
-    auto add = [&](std::array<int, 3> p, std::array<int, 3> q, std::array<int, 3> r) {
-      // Out of the octahedron, decided on the octahedron itself (along the face's normal, `sign`).
-      const Vector3d u(q[0] - p[0], q[1] - p[1], q[2] - p[2]), v(r[0] - p[0], r[1] - p[1], r[2] - p[2]);
-      if (u.cross(v).dot(Vector3d(sign[0], sign[1], sign[2])) < 0) std::swap(q, r);
-      surface.triangles.push_back({point(p), point(q), point(r)});
-    };
-    for (int a = 0; a < n; ++a)
-      for (int b = 0; a + b < n; ++b) {
-        add(at(a, b), at(a + 1, b), at(a, b + 1));
-        if (a + b + 2 <= n) add(at(a + 1, b), at(a + 1, b + 1), at(a, b + 1));
-      }
-  }
-  return surface;
-}
-
-}  // namespace
-
 TriangleSurface ellipsoid(const Vector3d& centre, const Vector3d& radii, int n, std::string name) {
-  return octahedral_sphere([&](const Vector3d& d) -> Vector3d { return centre + radii.cwiseProduct(d); }, n,
-                           std::move(name));
+  return triangulate_star_shaped([&](const Vector3d& d) -> Vector3d { return centre + radii.cwiseProduct(d); }, n,
+                                 std::move(name));
 }
 
 TriangleSurface sphere(int n) { return ellipsoid(Vector3d::Constant(0.5), Vector3d::Constant(0.3), n, "sphere"); }
@@ -205,7 +173,7 @@ TriangleSurface sphere(int n) { return ellipsoid(Vector3d::Constant(0.5), Vector
 TriangleSurface bumpy_blob(int n) {
   const std::array<Vector3d, 3> bumps{Vector3d(1, 0.3, 0.2).normalized(), Vector3d(-0.4, 1, 0.5).normalized(),
                                       Vector3d(0.1, -0.6, -1).normalized()};
-  return octahedral_sphere(
+  return triangulate_star_shaped(
       [&](const Vector3d& d) -> Vector3d {
         double b = 0.0;
         for (const Vector3d& bump : bumps) b += std::exp(-(d - bump).squaredNorm() / 0.3);

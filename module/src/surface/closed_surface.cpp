@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <utility>
 
 namespace meccano {
 
@@ -83,6 +84,34 @@ std::optional<PlaneCut> cut_by_plane(const TriangleSurface& surface, int axis, d
     }
   }
   return cut;
+}
+
+TriangleSurface triangulate_star_shaped(const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& place, int n,
+                                        std::string name) {
+  TriangleSurface surface;
+  surface.name = std::move(name);
+  std::map<std::array<int, 3>, int> index;  // integer point on the octahedron, times n
+  auto point = [&](const std::array<int, 3>& q) {
+    const auto [it, added] = index.try_emplace(q, static_cast<int>(surface.points.size()));
+    if (added) surface.points.push_back(place(Eigen::Vector3d(q[0], q[1], q[2]).normalized()));
+    return it->second;
+  };
+  for (int face = 0; face < 8; ++face) {
+    const std::array<int, 3> sign{face & 1 ? -1 : 1, face & 2 ? -1 : 1, face & 4 ? -1 : 1};
+    auto at = [&](int a, int b) { return std::array<int, 3>{sign[0] * a, sign[1] * b, sign[2] * (n - a - b)}; };
+    auto add = [&](std::array<int, 3> p, std::array<int, 3> q, std::array<int, 3> r) {
+      // Out of the octahedron, decided on the octahedron itself (along the face's normal, `sign`).
+      const Eigen::Vector3d u(q[0] - p[0], q[1] - p[1], q[2] - p[2]), v(r[0] - p[0], r[1] - p[1], r[2] - p[2]);
+      if (u.cross(v).dot(Eigen::Vector3d(sign[0], sign[1], sign[2])) < 0) std::swap(q, r);
+      surface.triangles.push_back({point(p), point(q), point(r)});
+    };
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; a + b < n; ++b) {
+        add(at(a, b), at(a + 1, b), at(a, b + 1));
+        if (a + b + 2 <= n) add(at(a + 1, b), at(a + 1, b + 1), at(a, b + 1));
+      }
+  }
+  return surface;
 }
 
 }  // namespace meccano

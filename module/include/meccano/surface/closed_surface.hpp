@@ -14,6 +14,9 @@
 //        the other. Where the plane passes within cut_snap of an edge's span along the axis from a vertex
 //        of that edge, the vertex counts as on the plane instead (a crossing there would leave a sliver):
 //        the cut then runs through it, a little off the plane, and no point of S moves.
+//        triangulate_star_shaped: a closed surface for tests and demos (spheres, ellipsoids, blobs): the
+//        octahedron |x| + |y| + |z| = 1 with each face cut into n^2 triangles, every point p placed at
+//        place(p / |p|), normals pointing out when `place` keeps the directions' order (a star-shaped image).
 // Input  a surface that passed require_surface_topology (surface/validation.hpp).
 // Output of cut_by_plane: the parts' triangles keep S's orientation. Empty when some triangle lies in the
 //        plane. Whether each part is a disk is the caller's question (the plane may cut S in several loops).
@@ -22,7 +25,9 @@
 #include <meccano/surface/triangle_surface.hpp>
 
 #include <array>
+#include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace meccano {
@@ -41,5 +46,8 @@ struct PlaneCut {
 };
 
 std::optional<PlaneCut> cut_by_plane(const TriangleSurface& surface, int axis, double offset);
+
+TriangleSurface triangulate_star_shaped(const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& place, int n,
+                                        std::string name);
 
 }  // namespace meccano

@@ -62,6 +62,10 @@ Eigen::Vector3d cube_example_normal(double x, double y) {
   return Eigen::Vector3d(-h.s_x, -h.s_y, 1.0).normalized();
 }
 
+Eigen::Vector3d project_onto_cube_example(const Eigen::Vector3d& p) {
+  return {p.x(), p.y(), cube_example_height(p.x(), p.y())};
+}
+
 ValueAndGradient manufactured_solution(const Eigen::Vector3d& p) {
   ValueAndGradient u = smooth_part(p);
   const Cutoff c = cutoff(p.x(), p.y());
@@ -113,40 +117,14 @@ meccano::TriangleSurface triangulate_cube_example(int n) {
 }
 
 SurfaceMatch match_cube_example_surface(const meccano::DealiiInterface& interface) {
-  SurfaceMatch match;
-  if (interface.corners.empty()) {
+  SurfaceMatch match = match_surface(interface, project_onto_cube_example);
+  const auto over_q = [&](const dealii::Point<3>& p) {
+    return p[0] >= origin - match.tolerance && p[0] <= origin + side + match.tolerance &&
+           p[1] >= origin - match.tolerance && p[1] <= origin + side + match.tolerance;
+  };
+  if (!std::all_of(interface.corners.begin(), interface.corners.end(), over_q))
     match.max_deviation = std::numeric_limits<double>::infinity();
-    return match;
-  }
-  double edge_sum = 0.0;
-  for (std::size_t t = 0; t < interface.triangles(); ++t)
-    for (int i = 0; i < 3; ++i) edge_sum += (corner(interface, t, i) - corner(interface, t, (i + 1) % 3)).norm();
-  match.tolerance = 0.05 * edge_sum / static_cast<double>(interface.corners.size());
-  for (const dealii::Point<3>& p : interface.corners) {
-    const double x = p[0], y = p[1];
-    const bool over_q = x >= origin - match.tolerance && x <= origin + side + match.tolerance &&
-                        y >= origin - match.tolerance && y <= origin + side + match.tolerance;
-    match.max_deviation = std::max(match.max_deviation, over_q ? std::abs(p[2] - cube_example_height(x, y))
-                                                               : std::numeric_limits<double>::infinity());
-  }
   return match;
-}
-
-NormalError cube_example_normal_error(const meccano::DealiiInterface& interface) {
-  NormalError error;
-  double area_sum = 0.0, weighted_sum = 0.0;
-  for (std::size_t t = 0; t < interface.triangles(); ++t) {
-    const Eigen::Vector3d normal = triangle_normal(interface, t);
-    const Eigen::Vector3d center = centroid(interface, t);
-    const double cosine = std::abs(normal.normalized().dot(cube_example_normal(center.x(), center.y())));
-    const double angle = std::acos(std::min(1.0, cosine)) * 180.0 / pi;
-    error.per_triangle_deg.push_back(angle);
-    error.max_deg = std::max(error.max_deg, angle);
-    area_sum += normal.norm();
-    weighted_sum += normal.norm() * angle;
-  }
-  error.mean_deg = area_sum > 0.0 ? weighted_sum / area_sum : 0.0;
-  return error;
 }
 
 }  // namespace solver_demo

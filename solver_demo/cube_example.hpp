@@ -30,8 +30,9 @@ struct ValueAndGradient {
   Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
 };
 
-double cube_example_height(double x, double y);           // s(x, y)
-Eigen::Vector3d cube_example_normal(double x, double y);  // unit, towards +z
+double cube_example_height(double x, double y);                       // s(x, y)
+Eigen::Vector3d cube_example_normal(double x, double y);              // unit, towards +z
+Eigen::Vector3d project_onto_cube_example(const Eigen::Vector3d& p);  // the point of S's formula over p
 
 ValueAndGradient manufactured_solution(const Eigen::Vector3d& p);  // u and ∇u (one-sided on S)
 double manufactured_right_hand_side(const Eigen::Vector3d& p);     // f = −Δu off S
@@ -41,23 +42,7 @@ double manufactured_interface_source(const Eigen::Vector3d& p);    // g_S at (x,
 // triangulation as meshes/generate_surfaces.py writes, named "patch".
 meccano::TriangleSurface triangulate_cube_example(int n);
 
-// Whether `interface` is S: every corner of its triangles lies over Q and within `tolerance` of s in
-// z. The tolerance is relative to the mesh: 5 % of the interface's mean edge length, far below the
-// distance to any other surface the demo meets, far above the sag of a fine triangulation of S.
-struct SurfaceMatch {
-  double max_deviation = 0.0;  // max |z − s(x, y)| over the corners (∞ if one is outside Q)
-  double tolerance = 0.0;
-  bool matches() const { return max_deviation <= tolerance; }
-};
+// Whether `interface` is S (match_surface, interface_triangles.hpp), and every corner of it over Q.
 SurfaceMatch match_cube_example_surface(const meccano::DealiiInterface& interface);
-
-// Angles between the interface triangles' normals and S's normal at the point over each centroid, as
-// unoriented lines (a triangle's orientation is a property of the file, not of the approximation).
-struct NormalError {
-  double max_deg = 0.0;
-  double mean_deg = 0.0;                 // area-weighted
-  std::vector<double> per_triangle_deg;  // in the order of the interface's triangles
-};
-NormalError cube_example_normal_error(const meccano::DealiiInterface& interface);
 
 }  // namespace solver_demo

@@ -3,6 +3,8 @@
 
 #include "interface_poisson.hpp"
 
+#include "curved_interface.hpp"
+
 #include <meccano/io/atomic_file.hpp>
 
 #include <deal.II/base/function.h>
@@ -27,6 +29,7 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -35,17 +38,35 @@ namespace solver_demo {
 using namespace dealii;
 
 InterfaceProblem manufactured_problem() {
-  return {"manufactured solution of the cube example (doc/solver.md)", manufactured_right_hand_side,
-          [](const Eigen::Vector3d& p) { return manufactured_solution(p).value; }, manufactured_interface_source,
-          manufactured_solution};
+  using material_id = InterfaceProblem::material_id;
+  return {"manufactured solution of the cube example (doc/solver.md)",
+          [](material_id) { return 1.0; },
+          [](const Eigen::Vector3d& p, material_id) { return manufactured_right_hand_side(p); },
+          [](const Eigen::Vector3d& p) { return manufactured_solution(p).value; },
+          manufactured_interface_source,
+          [](const Eigen::Vector3d& p, material_id) { return manufactured_solution(p); },
+          ExactSurface{project_onto_cube_example,
+                       [](const Eigen::Vector3d& p) { return cube_example_normal(p.x(), p.y()); }}};
+}
+
+InterfaceProblem inclusion_problem(dealii::types::material_id inside) {
+  using material_id = InterfaceProblem::material_id;
+  return {"coefficient jump across the inclusion example's sphere (doc/solver.md)",
+          [inside](material_id m) { return m == inside ? inclusion.beta_inside : inclusion.beta_outside; },
+          [inside](const Eigen::Vector3d& p, material_id m) { return inclusion_right_hand_side(p, m == inside); },
+          [](const Eigen::Vector3d& p) { return inclusion_solution(p, false).value; },
+          [](const Eigen::Vector3d&) { return 0.0; },
+          [inside](const Eigen::Vector3d& p, material_id m) { return inclusion_solution(p, m == inside); },
+          ExactSurface{project_onto_inclusion, inclusion_normal}};
 }
 
 InterfaceProblem unit_source_problem() {
-  const auto zero = [](const Eigen::Vector3d&) { return 0.0; };
   return {"-Δu = 0, u = 0 on the box sides, unit flux jump on S",
-          zero,
-          zero,
+          [](InterfaceProblem::material_id) { return 1.0; },
+          [](const Eigen::Vector3d&, InterfaceProblem::material_id) { return 0.0; },
+          [](const Eigen::Vector3d&) { return 0.0; },
           [](const Eigen::Vector3d&) { return 1.0; },
+          {},
           {}};
 }
 
@@ -72,12 +93,14 @@ class InterfacePoisson {
 
   MPI_Comm communicator;
   const InterfaceProblem& problem;
+  // Cells curved onto S (see the header): P2 with S known exactly.
+  const bool curved;
 
   parallel::fullydistributed::Triangulation<3> triangulation;
   // The S faces this rank integrates over: each face once, from its negative side.
   std::vector<meccano::InterfaceCellFace> interface_faces;
 
-  // Tets are mapped affinely; S is made of flat faces, so higher-order geometry would gain nothing.
+  // Affine tets, or degree-2 ones whose edges on S_h are curved onto S.
   const MappingFE<3> mapping;
   const FE_SimplexP<3> fe;
   DoFHandler<3> dof_handler;
@@ -95,23 +118,31 @@ class InterfacePoisson {
 InterfacePoisson::InterfacePoisson(MPI_Comm communicator_, unsigned int degree, const InterfaceProblem& problem_)
     : communicator(communicator_),
       problem(problem_),
+      curved(degree > 1 && problem_.exact_surface.has_value()),
       triangulation(communicator_),
-      mapping(FE_SimplexP<3>(1)),
+      mapping(FE_SimplexP<3>(curved ? degree : 1)),
       fe(degree),
       dof_handler(triangulation) {}
 
 // Rank 0 builds the whole coarse mesh and METIS cuts it into one part per rank; each rank receives its
 // cells and one layer of ghosts. The manifold id of S's faces survives the distribution. Each rank
-// then harvests the S faces of the cells it owns, by their corners in rank 0's interfaces, and resets
-// every manifold id to flat: MappingFE insists (in Debug) that all parts of a cell share the cell's
-// manifold id.
-void InterfacePoisson::make_grid(const meccano::DealiiMesh& mesh, const std::string& interface_name) {
+// then harvests the S faces of the cells it owns, by their corners in rank 0's interfaces, and gives
+// every cell, face and line one manifold id, as MappingFE insists (in Debug): flat, or for a curved
+// geometry the InterfaceEdgeManifold, after S_h's vertices have been moved onto S.
+void InterfacePoisson::make_grid(const meccano::DealiiMesh& input, const std::string& interface_name) {
+  std::optional<meccano::DealiiMesh> moved;
+  if (curved && Utilities::MPI::this_mpi_process(communicator) == 0)
+    moved = with_interface_on_surface(input, interface_name, problem.exact_surface->project);
+  const meccano::DealiiMesh& mesh = moved ? *moved : input;
   triangulation.create_triangulation(meccano::fullydistributed_description(mesh, communicator));
   meccano::DealiiMesh every_rank;  // rank 0's interfaces only
   every_rank.interfaces = Utilities::MPI::broadcast(communicator, mesh.interfaces, 0);
   const meccano::DealiiInterface& interface = every_rank.interface(interface_name);
   interface_faces = meccano::interface_cell_faces(triangulation, interface);
-  triangulation.set_all_manifold_ids(numbers::flat_manifold_id);
+  const types::manifold_id geometry = curved ? types::manifold_id(0) : numbers::flat_manifold_id;
+  triangulation.set_all_manifold_ids(geometry);
+  if (curved) triangulation.set_manifold(geometry, InterfaceEdgeManifold(interface, problem.exact_surface->project));
+  report.curved = curved;
 
   double h = 0.0;
   for (const auto& cell : triangulation.active_cell_iterators())
@@ -151,7 +182,7 @@ void InterfacePoisson::setup_system() {
   system_matrix.reinit(locally_owned_dofs, locally_owned_dofs, dsp, communicator);
 }
 
-// A_ij = ∫_Ω ∇φ_i·∇φ_j and F_i = ∫_Ω f φ_i cell by cell, then F_i += ∫_S g_S φ_i face by face. The
+// A_ij = ∫_Ω β ∇φ_i·∇φ_j and F_i = ∫_Ω f φ_i cell by cell, then F_i += ∫_S g_S φ_i face by face. The
 // surface term is what makes the gradient of u_h jump across S; it has no matrix part, so the
 // constraints only drop its constrained rows.
 void InterfacePoisson::assemble_system() {
@@ -168,11 +199,12 @@ void InterfacePoisson::assemble_system() {
     fe_values.reinit(cell);
     cell_matrix = 0;
     cell_rhs = 0;
+    const double beta = problem.coefficient(cell->material_id());
     for (const unsigned int q : fe_values.quadrature_point_indices()) {
-      const double f = problem.right_hand_side(to_eigen(fe_values.quadrature_point(q)));
+      const double f = problem.right_hand_side(to_eigen(fe_values.quadrature_point(q)), cell->material_id());
       for (const unsigned int i : fe_values.dof_indices()) {
         for (const unsigned int j : fe_values.dof_indices())
-          cell_matrix(i, j) += fe_values.shape_grad(i, q) * fe_values.shape_grad(j, q) * fe_values.JxW(q);
+          cell_matrix(i, j) += beta * fe_values.shape_grad(i, q) * fe_values.shape_grad(j, q) * fe_values.JxW(q);
         cell_rhs(i) += f * fe_values.shape_value(i, q) * fe_values.JxW(q);
       }
     }
@@ -239,14 +271,15 @@ void InterfacePoisson::evaluate() {
     fe_values.reinit(cell);
     fe_values.get_function_values(locally_relevant_solution, values);
     fe_values.get_function_gradients(locally_relevant_solution, gradients);
+    const types::material_id material = cell->material_id();
     for (const unsigned int q : fe_values.quadrature_point_indices()) {
       const Eigen::Vector3d x = to_eigen(fe_values.quadrature_point(q));
       const double dx = fe_values.JxW(q);
       l2 += values[q] * values[q] * dx;
       h1 += gradients[q] * gradients[q] * dx;
-      source += problem.right_hand_side(x) * dx;
+      source += problem.right_hand_side(x, material) * dx;
       if (problem.exact_solution) {
-        const ValueAndGradient u = problem.exact_solution(x);
+        const ValueAndGradient u = problem.exact_solution(x, material);
         l2_error += (u.value - values[q]) * (u.value - values[q]) * dx;
         h1_error += (to_tensor(u.gradient) - gradients[q]).norm_square() * dx;
       }
@@ -256,7 +289,8 @@ void InterfacePoisson::evaluate() {
       fe_face_values.reinit(cell, f);
       fe_face_values.get_function_gradients(locally_relevant_solution, face_gradients);
       for (const unsigned int q : fe_face_values.quadrature_point_indices())
-        outflow -= face_gradients[q] * fe_face_values.normal_vector(q) * fe_face_values.JxW(q);
+        outflow -=
+            problem.coefficient(material) * face_gradients[q] * fe_face_values.normal_vector(q) * fe_face_values.JxW(q);
     }
   }
   for (const meccano::InterfaceCellFace& face : interface_faces) {
@@ -284,10 +318,17 @@ void InterfacePoisson::output_results(const std::string& prefix) const {
 
   TrilinosWrappers::MPI::Vector error;  // u_h − I_h u, where u is known
   if (problem.exact_solution) {
+    // Each cell's side formula; the two agree on S.
+    std::map<types::material_id, ScalarFunctionFromFunctionObject<3>> exact;
+    std::map<types::material_id, const Function<3>*> exact_by_material;
+    for (const auto& cell : triangulation.active_cell_iterators()) {
+      const types::material_id m = cell->material_id();
+      const auto [function, added] =
+          exact.try_emplace(m, [this, m](const Point<3>& p) { return problem.exact_solution(to_eigen(p), m).value; });
+      if (added) exact_by_material.emplace(m, &function->second);
+    }
     TrilinosWrappers::MPI::Vector interpolant(locally_owned_dofs, communicator);
-    const ScalarFunctionFromFunctionObject<3> exact(
-        [this](const Point<3>& p) { return problem.exact_solution(to_eigen(p)).value; });
-    VectorTools::interpolate(mapping, dof_handler, exact, interpolant);
+    VectorTools::interpolate_based_on_material_id(mapping, dof_handler, exact_by_material, interpolant);
     TrilinosWrappers::MPI::Vector difference(locally_owned_dofs, communicator);
     difference = locally_relevant_solution;
     difference -= interpolant;

@@ -1,10 +1,12 @@
-// The demo solver: a Poisson problem with a flux jump on a surface S immersed in a tet mesh.
+// The demo solver: an elliptic problem with a surface S immersed in a tet mesh, across which the solution's
+// gradient jumps, by a flux source on S or by a jump of the coefficient:
 //
-//   −Δu = f in Ω,   u = g_D on ∂Ω,   ∂u/∂n|⁻ − ∂u/∂n|⁺ = g_S on S,
+//   −∇·(β∇u) = f in Ω,   u = g_D on ∂Ω,   β∂u/∂n|⁻ − β∂u/∂n|⁺ = g_S on S,
 //
-// whose weak form is: find u ∈ H¹(Ω), u = g_D on ∂Ω, with ∫_Ω ∇u·∇v = ∫_Ω f v + ∫_S g_S v for all
-// v ∈ H¹₀(Ω). S enters only through that surface integral, so the mesh must have S as a set of faces
-// (the module's output); u is continuous across S and its gradient jumps there.
+// whose weak form is: find u ∈ H¹(Ω), u = g_D on ∂Ω, with ∫_Ω β ∇u·∇v = ∫_Ω f v + ∫_S g_S v for all
+// v ∈ H¹₀(Ω). S enters through that surface integral and through β, constant on each cell and set by
+// its material id (the cells a closed S encloses have their own), so the mesh must have S as a set of
+// faces (the module's output); u is continuous across S and its gradient jumps there.
 //
 // Input    the mesh as the deal.II adapter gives it (meccano::DealiiMesh, from an insertion or an MSH
 //          file; only MPI rank 0's copy is read), the name of its interface S (DealiiMesh::interface:
@@ -13,14 +15,19 @@
 // Method   deal.II 9.4 on parallel::fullydistributed::Triangulation (any number of MPI ranks, one
 //          included), built from meccano::fullydistributed_description: rank 0 builds the coarse mesh
 //          with S's faces marked by their manifold id, METIS partitions it; each rank takes the S faces
-//          of the cells it owns on S's negative side (meccano::interface_cell_faces) and the manifold
-//          ids are reset to flat before any FEValues. u = g_D on every boundary face, whatever its
-//          boundary id (box sides 1-6, other faces 0). CG with Trilinos ML AMG, relative residual 1e-12.
+//          of the cells it owns on S's negative side (meccano::interface_cell_faces). u = g_D on every
+//          boundary face, whatever its boundary id (box sides 1-6, other faces 0). CG with Trilinos ML
+//          AMG, relative residual 1e-12.
+//          Geometry: affine tets, S_h's faces flat; for P2 when the problem knows S exactly
+//          (InterfaceProblem::exact_surface), the cells are curved onto S instead: S_h's vertices are
+//          moved onto S and a degree-2 MappingFE puts the midpoints of S_h's edges on S
+//          (InterfaceEdgeManifold), so that S is represented to O(h³), as P2's L2 rate needs.
 // Output   a SolveReport: sizes, CG iterations, the flux balance, the solution's norms, and the errors
 //          in L2 and in the H1 seminorm when the exact solution is known; optionally VTU files.
 #pragma once
 
 #include "cube_example.hpp"
+#include "inclusion_example.hpp"
 #include "interface_triangles.hpp"
 
 #include <deal.II/base/mpi.h>
@@ -32,24 +39,40 @@
 
 namespace solver_demo {
 
+// S as a formula, where the problem knows it.
+struct ExactSurface {
+  SurfaceProjection project;
+  std::function<Eigen::Vector3d(const Eigen::Vector3d&)> normal;  // S's unit normal at project(p)
+};
+
+// The data are functions of the point and, where they differ on the two sides of a closed S, of the cell's
+// material id (meccano::domain_tag outside every inclusion, 2 + k inside the closed surface k): each side's
+// formula is smooth across S, and a quadrature point of a cell between S and S_h takes its cell's side.
 struct InterfaceProblem {
+  using material_id = dealii::types::material_id;
   std::string description;
-  std::function<double(const Eigen::Vector3d&)> right_hand_side;           // f
-  std::function<double(const Eigen::Vector3d&)> boundary_values;           // g_D
-  std::function<double(const Eigen::Vector3d&)> interface_source;          // g_S
-  std::function<ValueAndGradient(const Eigen::Vector3d&)> exact_solution;  // empty when unknown
+  std::function<double(material_id)> coefficient;                                       // β
+  std::function<double(const Eigen::Vector3d&, material_id)> right_hand_side;           // f
+  std::function<double(const Eigen::Vector3d&)> boundary_values;                        // g_D
+  std::function<double(const Eigen::Vector3d&)> interface_source;                       // g_S
+  std::function<ValueAndGradient(const Eigen::Vector3d&, material_id)> exact_solution;  // empty when unknown
+  std::optional<ExactSurface> exact_surface;                                            // empty when unknown
 };
 
 // The cube example's manufactured solution (cube_example.hpp); S must be the cube example's surface.
 InterfaceProblem manufactured_problem();
-// Any surface: f = 0, g_D = 0, g_S = 1. u is the potential of a uniform source on S.
+// The inclusion example's coefficient jump (inclusion_example.hpp); S must be its sphere, and the cells
+// inside it must carry `inside` as material id (2 for the mesh's first surface).
+InterfaceProblem inclusion_problem(dealii::types::material_id inside = 2);
+// Any surface: β = 1, f = 0, g_D = 0, g_S = 1. u is the potential of a uniform source on S.
 InterfaceProblem unit_source_problem();
 
 struct SolveReport {
   unsigned long long cells = 0;
   unsigned long long dofs = 0;
   unsigned long long interface_faces = 0;
-  double h = 0.0;  // longest edge
+  double h = 0.0;       // longest edge
+  bool curved = false;  // cells curved onto S (InterfaceProblem::exact_surface, P2)
   unsigned int cg_iterations = 0;
   // Flux balance: what the sources put in, ∫_Ω f + ∫_S g_S, against what leaves through the box sides
   // by the discrete gradient, −∫_∂Ω ∇u_h·n. Equal for the exact solution; they agree as h → 0.

@@ -2,8 +2,12 @@
 
 #include <meccano/io/atomic_file.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <limits>
 #include <map>
+#include <numbers>
 
 namespace solver_demo {
 
@@ -11,6 +15,38 @@ double interface_area(const meccano::DealiiInterface& interface) {
   double area = 0.0;
   for (std::size_t t = 0; t < interface.triangles(); ++t) area += 0.5 * triangle_normal(interface, t).norm();
   return area;
+}
+
+SurfaceMatch match_surface(const meccano::DealiiInterface& interface, const SurfaceProjection& project) {
+  SurfaceMatch match;
+  if (interface.corners.empty()) {
+    match.max_deviation = std::numeric_limits<double>::infinity();
+    return match;
+  }
+  double edge_sum = 0.0;
+  for (std::size_t t = 0; t < interface.triangles(); ++t)
+    for (int i = 0; i < 3; ++i) edge_sum += (corner(interface, t, i) - corner(interface, t, (i + 1) % 3)).norm();
+  match.tolerance = 0.05 * edge_sum / static_cast<double>(interface.corners.size());
+  for (const dealii::Point<3>& p : interface.corners)
+    match.max_deviation = std::max(match.max_deviation, (project(to_eigen(p)) - to_eigen(p)).norm());
+  return match;
+}
+
+NormalError normal_error(const meccano::DealiiInterface& interface,
+                         const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& exact_normal) {
+  NormalError error;
+  double area_sum = 0.0, weighted_sum = 0.0;
+  for (std::size_t t = 0; t < interface.triangles(); ++t) {
+    const Eigen::Vector3d normal = triangle_normal(interface, t);
+    const double cosine = std::abs(normal.normalized().dot(exact_normal(centroid(interface, t))));
+    const double angle = std::acos(std::min(1.0, cosine)) * 180.0 / std::numbers::pi;
+    error.per_triangle_deg.push_back(angle);
+    error.max_deg = std::max(error.max_deg, angle);
+    area_sum += normal.norm();
+    weighted_sum += normal.norm() * angle;
+  }
+  error.mean_deg = area_sum > 0.0 ? weighted_sum / area_sum : 0.0;
+  return error;
 }
 
 void write_interface_vtu(const meccano::DealiiInterface& interface, const std::vector<TriangleField>& fields,

@@ -29,11 +29,16 @@ Solves -Δu = f in the mesh's domain, u = g_D on its boundary, with the flux jum
 du/dn|below - du/dn|above = g_S on the immersed surface S (the triangles of the 2D physical group
 interface_NAME), with continuous P1 or P2 elements on the tets (deal.II, CG + Trilinos ML AMG).
 
-If S is the cube example's surface (meshes/cube_example.obj: every interface node on its formula, to
-5 % of the mean interface edge), the problem is the manufactured one of doc/solver.md, and the errors
-in L2 and in the H1 seminorm and the angles between the faces' normals and S's are printed.
-Otherwise f = 0, g_D = 0 and g_S = 1, and the solution's norms are printed. Both print the flux
-balance: int_Omega f + int_S g_S against the outflow -int_boundary grad u_h . n.
+If S is a surface of doc/solver.md's manufactured problems (every interface node on its formula, to
+5 % of the mean interface edge), that problem is solved, and the errors in L2 and in the H1 seminorm
+and the angles between the faces' normals and S's are printed:
+  the cube example's surface (meshes/cube_example.obj): the flux jump above;
+  the inclusion's sphere (radius 0.3 about (0.5, 0.5, 0.5), with its cells in inside_NAME: the
+  mesh's only volume group, every cell of it inside the sphere): -div(beta grad u) = f with
+  beta = 10 inside, 1 outside, no flux jump.
+With P2 the cells at S are then curved onto S (S_h's vertices and edge midpoints on S).
+Otherwise f = 0, g_D = 0 and g_S = 1, and the solution's norms are printed. All print the flux
+balance: int_Omega f + int_S g_S against the outflow -int_boundary beta grad u_h . n.
 
 Options:
   --mesh FILE.msh     Gmsh MSH (2.2 or 4.1, ASCII or binary) with linear tets and 2D groups
@@ -45,8 +50,9 @@ Options:
   --vtu PREFIX        write PREFIX.vtu (u_h, and u_h - I_h u where u is known; PREFIX.pvtu and
                       PREFIX.RANK.vtu under MPI) and PREFIX_interface.vtu (S's triangles)
   --report FILE.json  the run as JSON (rank 0 writes it): mesh, interface, degree, cells, dofs, h,
-                      cg_iterations, manufactured (true or false), errors {l2, h1} and
-                      normal_angle_deg {max, mean} for the manufactured problem, norms {l2,
+                      cg_iterations, problem (cube, inclusion or unit_source), manufactured
+                      (true or false), curved (true or false), errors {l2, h1} and
+                      normal_angle_deg {max, mean} for a manufactured problem, norms {l2,
                       h1_seminorm}, flux {source, outflow, relative_difference}, seconds {read, setup,
                       assembly, solve, postprocess, total} and ranks
 
@@ -59,14 +65,17 @@ double relative_flux_difference(const SolveReport& report) {
 
 // The run as JSON: the numbers the text output prints, at full precision.
 void write_report(const std::string& path, const Options& options, const meccano::DealiiInterface& interface,
-                  unsigned int degree, const SolveReport& report, const std::optional<NormalError>& normals,
-                  double read_seconds, double total_seconds, unsigned int ranks) {
+                  const std::string& problem, unsigned int degree, const SolveReport& report,
+                  const std::optional<NormalError>& normals, double read_seconds, double total_seconds,
+                  unsigned int ranks) {
   meccano::JsonWriter json;
   json.begin_object().key("mesh").value(options.at("--mesh"));
   json.key("interface").value("interface_" + interface.name);
   json.key("degree").value(degree).key("cells").value(report.cells).key("dofs").value(report.dofs);
   json.key("h").value(report.h).key("cg_iterations").value(report.cg_iterations);
-  json.key("manufactured").value(normals.has_value());  // the normals are measured against the cube example's S
+  json.key("problem").value(problem);
+  json.key("manufactured").value(normals.has_value());  // the normals are measured against the known S
+  json.key("curved").value(report.curved);
   if (normals) {
     json.key("errors").begin_object().key("l2").value(*report.l2_error).key("h1").value(*report.h1_error).end_object();
     json.key("normal_angle_deg").begin_object().key("max").value(normals->max_deg);
@@ -94,6 +103,48 @@ const meccano::DealiiInterface& file_interface(const meccano::DealiiMesh& mesh, 
   }
 }
 
+// Which manufactured problem the file's S belongs to, decided on rank 0 by S's nodes and, for the
+// inclusion, by the cells it encloses.
+struct Recognised {
+  std::string problem = "unit_source";  // or "cube", "inclusion"
+  SurfaceMatch cube, inclusion;
+  dealii::types::material_id inside = 0;  // the inclusion's cells
+};
+
+// The material id of the cells the inclusion encloses: the mesh's only one besides the domain's, with
+// every cell's centroid inside the sphere; none if there is no such material.
+std::optional<dealii::types::material_id> inclusion_material(const meccano::DealiiMesh& mesh) {
+  std::optional<dealii::types::material_id> inside;
+  for (const dealii::CellData<3>& cell : mesh.cells) {
+    if (cell.material_id == meccano::domain_tag) continue;
+    if (inside && *inside != cell.material_id) return std::nullopt;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const unsigned int v : cell.vertices) centroid += to_eigen(mesh.vertices[v]) / 4.0;
+    if ((centroid - inclusion.centre).norm() >= inclusion.radius) return std::nullopt;
+    inside = cell.material_id;
+  }
+  return inside;
+}
+
+Recognised recognise(const meccano::DealiiMesh& mesh, const meccano::DealiiInterface& interface) {
+  Recognised recognised;
+  recognised.cube = match_cube_example_surface(interface);
+  recognised.inclusion = match_surface(interface, project_onto_inclusion);
+  if (recognised.cube.matches()) {
+    recognised.problem = "cube";
+  } else if (const auto inside = inclusion_material(mesh); recognised.inclusion.matches() && inside) {
+    recognised.problem = "inclusion";
+    recognised.inside = *inside;
+  }
+  return recognised;
+}
+
+InterfaceProblem problem_named(const std::string& name, dealii::types::material_id inside) {
+  if (name == "cube") return manufactured_problem();
+  if (name == "inclusion") return inclusion_problem(inside);
+  return unit_source_problem();
+}
+
 void solve(MPI_Comm communicator, const Options& options) {
   const unsigned int degree = options.count("--degree") ? parse_degree(options.at("--degree")) : 1;
   const std::string vtu = options.count("--vtu") ? options.at("--vtu") : "";
@@ -104,15 +155,16 @@ void solve(MPI_Comm communicator, const Options& options) {
   const auto start = std::chrono::steady_clock::now();
   meccano::DealiiMesh mesh;
   const meccano::DealiiInterface* interface = nullptr;  // S, on rank 0
-  SurfaceMatch match;
+  Recognised recognised;
   if (root) {
     mesh = meccano::read_dealii_mesh(options.at("--mesh"));
     interface = &file_interface(mesh, interface_name);
-    match = match_cube_example_surface(*interface);
+    recognised = recognise(mesh, *interface);
   }
   const double read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const bool manufactured = dealii::Utilities::MPI::broadcast(communicator, match.matches(), 0);
-  const InterfaceProblem problem = manufactured ? manufactured_problem() : unit_source_problem();
+  const auto [problem_name, inside] =
+      dealii::Utilities::MPI::broadcast(communicator, std::make_pair(recognised.problem, recognised.inside), 0);
+  const InterfaceProblem problem = problem_named(problem_name, inside);
 
   const SolveReport report = solve_interface_problem(communicator, mesh, interface_name, degree, problem, vtu);
   const double total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -124,17 +176,24 @@ void solve(MPI_Comm communicator, const Options& options) {
   std::cout << std::setprecision(4) << "mesh        " << options.at("--mesh") << ": " << report.cells
             << " tets, h = " << report.h << " (longest edge); interface_" << surface.name << ": " << surface.triangles()
             << " triangles, area " << interface_area(surface) << '\n';
-  if (manufactured) {
-    normals = cube_example_normal_error(surface);
+  if (problem_name == "cube")
+    std::cout << "surface     the cube example's (nodes within " << recognised.cube.max_deviation
+              << " of its formula, tolerance " << recognised.cube.tolerance << "): the manufactured flux jump\n";
+  else if (problem_name == "inclusion")
+    std::cout << "surface     the inclusion's sphere (nodes within " << recognised.inclusion.max_deviation
+              << " of it, tolerance " << recognised.inclusion.tolerance << "; the cells of material " << inside
+              << " inside it): the manufactured coefficient jump\n";
+  else
+    std::cout << "surface     not the cube example's (nodes up to " << recognised.cube.max_deviation
+              << " off its formula, tolerance " << recognised.cube.tolerance
+              << ") nor the inclusion's with its cells: f = 0, g_D = 0, g_S = 1\n";
+  if (problem.exact_surface) {
+    normals = normal_error(surface, problem.exact_surface->normal);
     fields.emplace_back("normal_angle_deg", normals->per_triangle_deg);
-    std::cout << "surface     the cube example's (nodes within " << match.max_deviation << " of its formula, tolerance "
-              << match.tolerance << "): the manufactured solution\n"
-              << "normals     angle to S's normal: max " << normals->max_deg << " deg, mean " << normals->mean_deg
+    std::cout << "normals     angle to S's normal: max " << normals->max_deg << " deg, mean " << normals->mean_deg
               << " deg (area-weighted)\n";
-  } else {
-    std::cout << "surface     not the cube example's (nodes up to " << match.max_deviation
-              << " off its formula, tolerance " << match.tolerance << "): f = 0, g_D = 0, g_S = 1\n";
   }
+  if (report.curved) std::cout << "geometry    the cells at S curved onto S (degree-2 mapping)\n";
   std::cout << "system      P" << degree << ", " << report.dofs << " dofs, " << report.interface_faces
             << " faces on S, CG + AMG: " << report.cg_iterations << " iterations\n"
             << std::setprecision(12) << std::scientific;
@@ -142,7 +201,7 @@ void solve(MPI_Comm communicator, const Options& options) {
     std::cout << "L2 error    " << *report.l2_error << '\n' << "H1 error    " << *report.h1_error << '\n';
   std::cout << "norms       L2 " << report.l2_norm << ", H1 seminorm " << report.h1_seminorm << '\n'
             << "source      " << report.source << "  (int_Omega f + int_S g_S)\n"
-            << "outflow     " << report.outflow << "  (-int_boundary grad u_h . n)\n"
+            << "outflow     " << report.outflow << "  (-int_boundary beta grad u_h . n)\n"
             << std::setprecision(3) << "balance     relative difference " << relative_flux_difference(report) << '\n'
             << std::fixed << "seconds     read " << read_seconds << ", setup " << report.setup_seconds << ", assembly "
             << report.assembly_seconds << ", solve " << report.solve_seconds << ", evaluation and output "
@@ -156,8 +215,8 @@ void solve(MPI_Comm communicator, const Options& options) {
     write_interface_vtu(surface, fields, vtu + "_interface.vtu");
   }
   if (options.count("--report"))
-    write_report(options.at("--report"), options, surface, degree, report, normals, read_seconds, total_seconds,
-                 dealii::Utilities::MPI::n_mpi_processes(communicator));
+    write_report(options.at("--report"), options, surface, problem_name, degree, report, normals, read_seconds,
+                 total_seconds, dealii::Utilities::MPI::n_mpi_processes(communicator));
 }
 
 }  // namespace

@@ -1,9 +1,12 @@
-// The demo solver: the manufactured solution's formulas against finite differences; the deal.II
+// The demo solver: the manufactured solutions' formulas against finite differences; the deal.II
 // adapter it takes its meshes from (meccano/dealii_mesh.hpp) on the module's meshes in process and in
-// files, on reference-gmsh's, and on broken files; and the two programs end to end: errors that shrink
-// with h, the flux balance on another surface, and MPI runs equal to serial ones.
+// files, on reference-gmsh's, and on broken files; cells curved onto S; and the two programs end to
+// end: errors that shrink with h, the flux balance on another surface, and MPI runs equal to serial ones.
 
 #include "cube_example.hpp"
+#include "curved_interface.hpp"
+#include "inclusion_example.hpp"
+#include "interface_poisson.hpp"
 #include "interface_triangles.hpp"
 
 #include <meccano/error.hpp>
@@ -11,11 +14,16 @@
 #include <meccano/io/surface_readers.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/stages/pipeline.hpp>
+#include <meccano/surface/closed_surface.hpp>
 
 #include <run_command.hpp>
 #include <scratch_directory.hpp>
 #include <test_surfaces.hpp>
 
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/fe/fe_simplex_p.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/fe/mapping_fe.h>
 #include <deal.II/grid/tria.h>
 
 #include <gtest/gtest.h>
@@ -28,6 +36,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <numbers>
 #include <random>
 #include <regex>
 #include <set>
@@ -124,6 +133,100 @@ TEST(ManufacturedSolution, KinkFadesOutAtTheRim) {
     }
   EXPECT_EQ(manufactured_interface_source({0.2, 0.5, cube_example_height(0.2, 0.5)}), 0.0);
   EXPECT_EQ(manufactured_interface_source({0.1, 0.5, 0.5}), 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The inclusion's manufactured solution
+
+// Random points of the box, more than `gap` from S, with their side.
+std::vector<std::pair<Vector3d, bool>> points_off_sphere(int count, double gap) {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> coordinate(0.05, 0.95);
+  std::vector<std::pair<Vector3d, bool>> points;
+  while (static_cast<int>(points.size()) < count) {
+    const Vector3d p(coordinate(random), coordinate(random), coordinate(random));
+    const double r = (p - inclusion.centre).norm();
+    if (std::abs(r - inclusion.radius) > gap) points.emplace_back(p, r < inclusion.radius);
+  }
+  return points;
+}
+
+// Random points of S.
+std::vector<Vector3d> points_on_sphere(int count) {
+  std::mt19937 random(13);
+  std::normal_distribution<double> gaussian;
+  std::vector<Vector3d> points;
+  for (int i = 0; i < count; ++i)
+    points.push_back(
+        project_onto_inclusion(inclusion.centre + Vector3d(gaussian(random), gaussian(random), gaussian(random))));
+  return points;
+}
+
+TEST(InclusionSolution, GradientIsTheDerivativeOfTheValue) {
+  const double step = 1e-6;
+  for (const auto& [p, inside] : points_off_sphere(200, 1e-3)) {
+    const Vector3d gradient = inclusion_solution(p, inside).gradient;
+    for (int k = 0; k < 3; ++k) {
+      const Vector3d e = step * Vector3d::Unit(k);
+      const double difference =
+          (inclusion_solution(p + e, inside).value - inclusion_solution(p - e, inside).value) / (2.0 * step);
+      EXPECT_NEAR(gradient[k], difference, 1e-6 * (1.0 + std::abs(difference))) << "at " << p.transpose();
+    }
+  }
+}
+
+TEST(InclusionSolution, RightHandSideIsMinusBetaTimesTheLaplacian) {
+  const double step = 1e-4;
+  for (const auto& [p, inside] : points_off_sphere(200, 1e-2)) {
+    double laplacian = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const Vector3d e = step * Vector3d::Unit(k);
+      laplacian += (inclusion_solution(p + e, inside).value - 2.0 * inclusion_solution(p, inside).value +
+                    inclusion_solution(p - e, inside).value) /
+                   (step * step);
+    }
+    const double beta = inside ? inclusion.beta_inside : inclusion.beta_outside;
+    EXPECT_NEAR(inclusion_right_hand_side(p, inside), -beta * laplacian, 1e-4 * (1.0 + std::abs(beta * laplacian)))
+        << "at " << p.transpose();
+  }
+}
+
+// On S: u and the flux β ∂u/∂n are continuous (second-order one-sided differences along the normal,
+// each side by its own formula), the tangential gradient too, while ∂u/∂n itself jumps by the ratio of
+// the coefficients.
+TEST(InclusionSolution, ValueAndFluxAreContinuousAcrossS) {
+  const double step = 1e-4;
+  for (const Vector3d& p : points_on_sphere(200)) {
+    const Vector3d n = inclusion_normal(p);
+    const ValueAndGradient in = inclusion_solution(p, true), out = inclusion_solution(p, false);
+    EXPECT_NEAR(in.value, out.value, 1e-12) << "at " << p.transpose();
+    // ∂u/∂n from one side, by (3u(p) − 4u(p − hn) + u(p − 2hn)) / 2h with h = ±step.
+    const auto one_sided = [&](double h, bool inside) {
+      return (3.0 * inclusion_solution(p, inside).value - 4.0 * inclusion_solution(p - h * n, inside).value +
+              inclusion_solution(p - 2.0 * h * n, inside).value) /
+             (2.0 * h);
+    };
+    const double inner = one_sided(step, true), outer = one_sided(-step, false);
+    EXPECT_NEAR(inclusion.beta_inside * inner, inclusion.beta_outside * outer, 3e-5) << "at " << p.transpose();
+    EXPECT_NEAR(inner, in.gradient.dot(n), 3e-6);
+    EXPECT_NEAR(outer, out.gradient.dot(n), 3e-6);
+    const Vector3d tangential_jump = (in.gradient - out.gradient) - (in.gradient - out.gradient).dot(n) * n;
+    EXPECT_LT(tangential_jump.norm(), 1e-12);
+    // The kink: β ∂u/∂n = 2 A R on both sides.
+    EXPECT_NEAR(out.gradient.dot(n) - in.gradient.dot(n),
+                2.0 * inclusion.kink * inclusion.radius * (1.0 / inclusion.beta_outside - 1.0 / inclusion.beta_inside),
+                1e-9);
+  }
+}
+
+TEST(InclusionExample, TriangulationIsTheSphereWithNormalsOut) {
+  const meccano::TriangleSurface sphere = triangulate_inclusion(8);
+  EXPECT_EQ(sphere.triangles.size(), 8u * 8u * 8u);
+  EXPECT_TRUE(meccano::is_closed(sphere));
+  const double ball = 4.0 / 3.0 * std::numbers::pi * std::pow(inclusion.radius, 3);
+  EXPECT_GT(meccano::enclosed_volume(sphere), 0.95 * ball);  // inscribed: a little less than the ball
+  EXPECT_LT(meccano::enclosed_volume(sphere), ball);
+  for (const Vector3d& p : sphere.points) EXPECT_NEAR((p - inclusion.centre).norm(), inclusion.radius, 1e-15);
 }
 
 TEST(CubeExample, TriangulationIsTheExampleFile) {
@@ -411,7 +514,7 @@ TEST_F(AdapterTest, ReferenceGmshFileReads) {
 
   const Execution solve = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + path("gmsh.msh"));
   ASSERT_EQ(solve.status, 0) << solve.output;
-  EXPECT_NE(solve.output.find("the manufactured solution"), std::string::npos) << solve.output;
+  EXPECT_NE(solve.output.find("the manufactured flux jump"), std::string::npos) << solve.output;
   EXPECT_NE(solve.output.find(std::to_string(surface.triangles.size()) + " faces on S"), std::string::npos)
       << solve.output;
 }
@@ -423,11 +526,47 @@ TEST_F(AdapterTest, CubeExampleSurfaceIsRecognised) {
   EXPECT_TRUE(match.matches());
   EXPECT_LT(match.max_deviation, 0.25 * match.tolerance);  // nodes on a fine triangulation of S
   EXPECT_FALSE(match_cube_example_surface(meccano::dealii_mesh(insert(spherical_cap(), 9, 0.1)).interface()).matches());
-  const NormalError normals = cube_example_normal_error(patch);
+  const NormalError normals = normal_error(patch, manufactured_problem().exact_surface->normal);
   EXPECT_EQ(normals.per_triangle_deg.size(), patch.triangles());
   EXPECT_GT(normals.max_deg, 0.0);
   EXPECT_LT(normals.mean_deg, normals.max_deg);
   EXPECT_LT(normals.max_deg, 20.0);
+}
+
+// Cells curved onto S: on the inclusion's mesh, with S_h's vertices moved onto the sphere, a degree-2
+// MappingFE with the InterfaceEdgeManifold on every cell gives the box its volume exactly (the cells on
+// both sides of a curved face curve it alike: nothing overlaps, nothing is left open), a positive
+// Jacobian at every quadrature point, and the ball's volume to O(h⁴), where flat cells miss it by O(h²).
+TEST_F(AdapterTest, CellsCurvedOntoTheSphereFillTheBall) {
+  const meccano::DealiiMesh flat_mesh = meccano::dealii_mesh(insert(triangulate_inclusion(24), 9, 0.08));
+  const meccano::DealiiMesh mesh = with_interface_on_surface(flat_mesh, "", project_onto_inclusion);
+  for (const dealii::Point<3>& p : mesh.interface().corners)
+    EXPECT_NEAR((to_eigen(p) - inclusion.centre).norm(), inclusion.radius, 1e-15);
+  dealii::Triangulation<3> triangulation;
+  meccano::create_triangulation(mesh, triangulation);
+  triangulation.set_all_manifold_ids(0);
+  triangulation.set_manifold(0, InterfaceEdgeManifold(mesh.interface(), project_onto_inclusion));
+
+  const double ball = 4.0 / 3.0 * std::numbers::pi * std::pow(inclusion.radius, 3);
+  std::array<double, 2> ball_error{};  // flat, curved
+  for (const unsigned int degree : {1u, 2u}) {
+    const dealii::MappingFE<3> mapping(dealii::FE_SimplexP<3>{degree});
+    const dealii::FE_SimplexP<3> fe(1);
+    dealii::FEValues<3> values(mapping, fe, dealii::QGaussSimplex<3>(4), dealii::update_JxW_values);
+    double box = 0.0, inside = 0.0;
+    for (const auto& cell : triangulation.active_cell_iterators()) {
+      values.reinit(cell);
+      for (const unsigned int q : values.quadrature_point_indices()) {
+        ASSERT_GT(values.JxW(q), 0.0) << "cell " << cell->index();
+        box += values.JxW(q);
+        if (cell->material_id() == meccano::domain_tag + 1) inside += values.JxW(q);
+      }
+    }
+    EXPECT_NEAR(box, 1.0, 1e-12) << "degree " << degree;
+    ball_error[degree - 1] = std::abs(inside - ball);
+  }
+  EXPECT_GT(ball_error[0], 1e-3 * ball);           // flat: measured 6.5e-3 relative
+  EXPECT_LT(ball_error[1], 0.01 * ball_error[0]);  // curved: measured 4.4e-6 relative
 }
 
 void expect_input_error(const std::function<void()>& read, const std::vector<std::string>& parts) {
@@ -550,6 +689,49 @@ TEST_F(Programs, StudyErrorsShrinkWithH) {
   EXPECT_LT(fine[5], coarse[5]);
 }
 
+// The inclusion's coefficient jump on two small levels: errors shrinking by about the optimal factors
+// as h halves, for P1 (L2 by 4, H1 by 2) and for P2 on cells curved onto S (L2 by 8, H1 by 4).
+TEST_F(Programs, InclusionStudyConverges) {
+  for (const auto& [degree, l2_ratio, h1_ratio] : {std::tuple{"1", 3.4, 1.8}, std::tuple{"2", 6.0, 3.3}}) {
+    const Execution study = run_command(std::string(SOLVER_DEMO_STUDY) + " --levels 2 --problem inclusion --degree " +
+                                        degree + " --csv " + path("inclusion.csv"));
+    ASSERT_EQ(study.status, 0) << study.output;
+    std::string header;
+    const auto rows = read_csv(path("inclusion.csv"), header);
+    ASSERT_EQ(rows.size(), 2u);
+    // measured: P1 4.09 and 2.11, P2 7.17 and 3.77
+    EXPECT_GT(rows[0][3] / rows[1][3], l2_ratio) << "P" << degree;
+    EXPECT_GT(rows[0][4] / rows[1][4], h1_ratio) << "P" << degree;
+    EXPECT_LT(rows[1][5], rows[0][5]);  // the normals' error shrinks
+  }
+}
+
+// poisson_interface recognises the inclusion by its sphere and the cells inside it: with them it
+// solves the coefficient jump (P2 on curved cells) and its flux balance closes; without the inside_
+// group it cannot tell the coefficients apart and solves the unit source problem.
+TEST_F(Programs, InclusionFileIsRecognisedWithItsCells) {
+  const meccano::InsertionResult result = insert(triangulate_inclusion(24), 9, 0.08);
+  meccano::write_msh41(result.mesh, meccano::output_groups(result), path("ball.msh"));
+  const std::string without_inside = changed_file(result, "no_inside.msh", [](meccano::MeshGroups& groups) {
+    std::erase_if(groups.volumes, [](const auto& g) { return g.name.rfind("inside_", 0) == 0; });
+  });
+  const Execution solve = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + path("ball.msh") +
+                                      " --degree 2 --report " + path("ball.json"));
+  ASSERT_EQ(solve.status, 0) << solve.output;
+  EXPECT_NE(solve.output.find("the manufactured coefficient jump"), std::string::npos) << solve.output;
+  std::ifstream file(path("ball.json"));
+  const std::string report((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  for (const char* part : {"\"problem\": \"inclusion\"", "\"curved\": true", "\"manufactured\": true"})
+    EXPECT_NE(report.find(part), std::string::npos) << part << " missing from\n" << report;
+  EXPECT_LT(value_after(solve.output, "L2 error"), 0.01);                         // measured 5.0e-3
+  EXPECT_LT(value_after(solve.output, "balance     relative difference"), 0.02);  // measured 1.0e-2
+
+  const Execution unknown = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + without_inside);
+  ASSERT_EQ(unknown.status, 0) << unknown.output;
+  EXPECT_NE(unknown.output.find("nor the inclusion's with its cells"), std::string::npos) << unknown.output;
+  EXPECT_EQ(unknown.output.find("L2 error"), std::string::npos);
+}
+
 // On the spherical cap (not the cube example's surface) the unit source problem is solved: what S puts
 // in leaves through the box sides, to discretisation accuracy (measured: 2.0e-2 with P1, 4.0e-3 with P2;
 // on the next level 3.7e-3 and 5.1e-4).
@@ -587,7 +769,8 @@ TEST_F(Programs, TwoRanksGiveTheSerialErrors) {
                   " -n 2 --oversubscribe " + solve + " --vtu " + path("mpi"));
   ASSERT_EQ(serial.status, 0) << serial.output;
   ASSERT_EQ(parallel.status, 0) << parallel.output;
-  EXPECT_NE(serial.output.find("the manufactured solution"), std::string::npos) << serial.output;
+  EXPECT_NE(serial.output.find("the manufactured flux jump"), std::string::npos) << serial.output;
+  EXPECT_NE(serial.output.find("curved onto S"), std::string::npos) << serial.output;
   for (const char* label : {"L2 error", "H1 error", "source", "outflow"}) {
     const double one = value_after(serial.output, label), two = value_after(parallel.output, label);
     EXPECT_NEAR(one, two, 1e-9 * std::abs(one)) << label;

@@ -30,8 +30,10 @@ Height height(double x, double y) {
           (tilt * p + bump * pi * sp * cq) / side, -2.0 * bump * pi * pi * sp * sq / (side * side)};
 }
 
-// The cutoff w = B³, B = 16 p(1−p) q(1−q) on Q and 0 outside. B vanishes linearly at the rim, so w
-// vanishes there with its first and second derivatives: u's kink term is C² across the rim's column.
+// The cutoff w = B⁴, B = 16 p(1−p) q(1−q) on Q and 0 outside. B vanishes linearly at the rim, so w
+// vanishes there with three derivatives: u's kink term is C³ across the walls of the rim's column and
+// f = −Δu is C¹ there. (With B³, f was only C⁰ across those walls, which are no mesh faces; its
+// quadrature on the cells they cut cost O(h²) and capped P2's L2 rate at 2: doc/solver.md.)
 struct Cutoff {
   double w, w_x, w_y, laplacian;
 };
@@ -43,8 +45,8 @@ Cutoff cutoff(double x, double y) {
   const double B = bp * bq;
   const double B_x = 4.0 * (1.0 - 2.0 * p) * bq / side, B_y = 4.0 * (1.0 - 2.0 * q) * bp / side;
   const double B_laplacian = -8.0 * (bq + bp) / (side * side);
-  return {B * B * B, 3.0 * B * B * B_x, 3.0 * B * B * B_y,
-          6.0 * B * (B_x * B_x + B_y * B_y) + 3.0 * B * B * B_laplacian};
+  return {B * B * B * B, 4.0 * B * B * B * B_x, 4.0 * B * B * B * B_y,
+          12.0 * B * B * (B_x * B_x + B_y * B_y) + 4.0 * B * B * B * B_laplacian};
 }
 
 // The smooth part e^z sin(2x + y): nonzero on the box sides, −Δ of it is 4 times itself.

@@ -7,9 +7,9 @@
 //
 // S       the graph z = s(x, y) over Q = [0.2, 0.8]²: with p = (x − 0.2)/0.6, q = (y − 0.2)/0.6,
 //         s = 0.42 + 0.12 p q + 0.10 sin(πp) sin(πq), normal (−s_x, −s_y, 1)/|·| (meshes/cube_example.obj).
-// u       e^z sin(2x + y) − w(x, y) |z − s(x, y)| with the cutoff w = (16 p(1−p) q(1−q))³ on Q, 0 outside:
+// u       e^z sin(2x + y) − w(x, y) |z − s(x, y)| with the cutoff w = (16 p(1−p) q(1−q))⁴ on Q, 0 outside:
 //         continuous, smooth off S, with a kink across S whose size w fades out at the rim of S together
-//         with its first and second derivatives, so that u has no kink anywhere but on S.
+//         with three derivatives, so that u has no kink anywhere but on S and f is C¹ off S.
 // f       4 e^z sin(2x + y) + σ (d Δw − 2 ∇w·∇s − w Δs), d = z − s, σ = sign d (2D gradients).
 // g_S     2 w √(1 + |∇s|²) ≥ 0: S is a source, u has a ridge along it.
 //

@@ -9,6 +9,9 @@ cube_example.obj   the paper-like patch of the cube example: over (x, y) in [0.2
                    alternating diagonals, normals towards +z.
 spherical_cap.obj  a cap of the sphere of radius 0.4 centred at (0.5, 0.5, 0.2), polar angle up to 65
                    degrees: a circular rim, no natural corners.
+inclusion_sphere.obj  the demo solver's inclusion: the sphere of radius 0.3 centred at (0.5, 0.5, 0.5),
+                   a closed surface, the octahedron |x| + |y| + |z| = 1 with (N/2)^2 triangles per face
+                   pushed onto it (as meccano::triangulate_star_shaped), normals out.
 
 With --hard, instead: the hard surfaces of tests/data/hard_surfaces, which reproduce what makes real
 faults hard, in their units (UTM-like metres, x about 5e5, y about 3.8e6, z from -12 km to +1 km),
@@ -81,6 +84,40 @@ def spherical_cap(rings):
                     inner_next = previous[(sector * (r - 1) + k + 1) % len(previous)]
                     triangles.append((inner, outer_next, inner_next))
         previous = ring
+    return points, triangles
+
+
+def inclusion_sphere(n):
+    """The octahedron with n^2 triangles per face, its points pushed onto the sphere; the points in the
+    order meccano::triangulate_star_shaped numbers them, so that the two agree."""
+    centre, radius = (0.5, 0.5, 0.5), 0.3
+    points, triangles, index = [], [], {}
+
+    def point(q):
+        if q not in index:
+            index[q] = len(points)
+            norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2])
+            points.append(tuple(c + radius * (k / norm) for c, k in zip(centre, q)))
+        return index[q]
+
+    for face in range(8):
+        sign = (-1 if face & 1 else 1, -1 if face & 2 else 1, -1 if face & 4 else 1)
+
+        def at(a, b):
+            return (sign[0] * a, sign[1] * b, sign[2] * (n - a - b))
+
+        def add_triangle(p, q, r):
+            # Out of the octahedron, decided on the octahedron itself (along the face's normal, `sign`).
+            u, v = tuple(x - y for x, y in zip(q, p)), tuple(x - y for x, y in zip(r, p))
+            if sum(c * k for c, k in zip(cross(u, v), sign)) < 0:
+                q, r = r, q
+            triangles.append((point(p), point(q), point(r)))
+
+        for a in range(n):
+            for b in range(n - a):
+                add_triangle(at(a, b), at(a + 1, b), at(a, b + 1))
+                if a + b + 2 <= n:
+                    add_triangle(at(a + 1, b), at(a + 1, b + 1), at(a, b + 1))
     return points, triangles
 
 
@@ -379,8 +416,10 @@ HARD_SURFACES = {"creased": creased, "multiscale": multiscale, "thin_long": thin
 
 
 def main():
-    parser = argparse.ArgumentParser(description="Writes cube_example.obj and spherical_cap.obj, or the hard surfaces.")
-    parser.add_argument("n", nargs="?", type=int, default=48, help="grid resolution N (the cap gets N // 2 rings)")
+    parser = argparse.ArgumentParser(
+        description="Writes cube_example.obj, spherical_cap.obj and inclusion_sphere.obj, or the hard surfaces.")
+    parser.add_argument("n", nargs="?", type=int, default=48,
+                        help="grid resolution N (the cap gets N // 2 rings, the sphere N // 2 cells per octant edge)")
     parser.add_argument("--hard", action="store_true", help="write the hard surfaces of tests/data/hard_surfaces instead")
     parser.add_argument("--output-dir", default=".", help="folder to write into (created if missing)")
     args = parser.parse_args()
@@ -395,6 +434,8 @@ def main():
         return
     write_obj(path("cube_example.obj"), *cube_example(n), f"cube example patch, {n} x {n} grid (generate_surfaces.py)")
     write_obj(path("spherical_cap.obj"), *spherical_cap(n // 2), f"spherical cap, {n // 2} rings (generate_surfaces.py)")
+    write_obj(path("inclusion_sphere.obj"), *inclusion_sphere(n // 2),
+              f"inclusion sphere, {n // 2} cells per octant edge (generate_surfaces.py)")
 
 
 if __name__ == "__main__":

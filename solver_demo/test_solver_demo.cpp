@@ -230,6 +230,15 @@ TEST(InclusionSolution, ValueAndFluxAreContinuousAcrossS) {
   }
 }
 
+TEST(InclusionExample, TriangulationIsTheExampleFile) {
+  const meccano::TriangleSurface file =
+      meccano::read_surface(std::string(MECCANO_MESHES_DIR) + "/inclusion_sphere.obj");
+  const meccano::TriangleSurface made = triangulate_inclusion(24);
+  ASSERT_EQ(made.points.size(), file.points.size());
+  ASSERT_EQ(made.triangles, file.triangles);
+  for (std::size_t i = 0; i < made.points.size(); ++i) EXPECT_LT((made.points[i] - file.points[i]).norm(), 1e-12);
+}
+
 TEST(InclusionExample, TriangulationIsTheSphereWithNormalsOut) {
   const meccano::TriangleSurface sphere = triangulate_inclusion(8);
   EXPECT_EQ(sphere.triangles.size(), 8u * 8u * 8u);

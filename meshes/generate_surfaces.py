@@ -87,38 +87,44 @@ def spherical_cap(rings):
     return points, triangles
 
 
-def inclusion_sphere(n):
-    """The octahedron with n^2 triangles per face, its points pushed onto the sphere; the points in the
-    order meccano::triangulate_star_shaped numbers them, so that the two agree."""
-    centre, radius = (0.5, 0.5, 0.5), 0.3
-    points, triangles, index = [], [], {}
+def octahedral_sphere(place, n):
+    """The octahedron |x| + |y| + |z| = 1 with n^2 triangles per face, each point q mapped by
+    place(q / |q|), normals out of the octahedron; the points in the order meccano::triangulate_star_shaped
+    numbers them, so that the two agree. (tests/bench/closed_surfaces.py uses it too.)"""
+    index, points, triangles = {}, [], []
 
     def point(q):
         if q not in index:
             index[q] = len(points)
-            norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2])
-            points.append(tuple(c + radius * (k / norm) for c, k in zip(centre, q)))
+            r = math.sqrt(sum(c * c for c in q))
+            points.append(place(tuple(c / r for c in q)))
         return index[q]
 
     for face in range(8):
-        sign = (-1 if face & 1 else 1, -1 if face & 2 else 1, -1 if face & 4 else 1)
+        s = (-1 if face & 1 else 1, -1 if face & 2 else 1, -1 if face & 4 else 1)
 
-        def at(a, b):
-            return (sign[0] * a, sign[1] * b, sign[2] * (n - a - b))
+        def corner(a, b):
+            return (s[0] * a, s[1] * b, s[2] * (n - a - b))
 
         def add_triangle(p, q, r):
-            # Out of the octahedron, decided on the octahedron itself (along the face's normal, `sign`).
+            # Out of the octahedron, decided on the octahedron itself (a turned ellipsoid's normals are
+            # not along s).
             u, v = tuple(x - y for x, y in zip(q, p)), tuple(x - y for x, y in zip(r, p))
-            if sum(c * k for c, k in zip(cross(u, v), sign)) < 0:
+            if sum(c * k for c, k in zip(cross(u, v), s)) < 0:
                 q, r = r, q
             triangles.append((point(p), point(q), point(r)))
 
         for a in range(n):
             for b in range(n - a):
-                add_triangle(at(a, b), at(a + 1, b), at(a, b + 1))
+                add_triangle(corner(a, b), corner(a + 1, b), corner(a, b + 1))
                 if a + b + 2 <= n:
-                    add_triangle(at(a + 1, b), at(a + 1, b + 1), at(a, b + 1))
+                    add_triangle(corner(a + 1, b), corner(a + 1, b + 1), corner(a, b + 1))
     return points, triangles
+
+
+def inclusion_sphere(n):
+    centre, radius = (0.5, 0.5, 0.5), 0.3
+    return octahedral_sphere(lambda d: tuple(c + radius * k for c, k in zip(centre, d)), n)
 
 
 # ------------------------------------------------------------------------------------------------

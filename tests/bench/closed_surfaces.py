@@ -25,44 +25,12 @@ import math
 import os
 import random
 import subprocess
+import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-
-
-def octahedral_sphere(place, n):
-    """The octahedron |x|+|y|+|z| = 1 with n^2 triangles per face, each point mapped by place(unit d)."""
-    index, points, triangles = {}, [], []
-
-    def point(q):
-        if q not in index:
-            index[q] = len(points)
-            r = math.sqrt(sum(c * c for c in q))
-            points.append(place(tuple(c / r for c in q)))
-        return index[q]
-
-    for face in range(8):
-        s = (-1 if face & 1 else 1, -1 if face & 2 else 1, -1 if face & 4 else 1)
-
-        def corner(a, b):
-            return (s[0] * a, s[1] * b, s[2] * (n - a - b))
-
-        def add(p, q, r):
-            # Out of the octahedron, decided on the octahedron itself: a turned ellipsoid's normals are
-            # not along s.
-            u = [q[i] - p[i] for i in range(3)]
-            v = [r[i] - p[i] for i in range(3)]
-            normal = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
-            if sum(normal[i] * s[i] for i in range(3)) < 0:
-                q, r = r, q
-            triangles.append((point(p), point(q), point(r)))
-
-        for a in range(n):
-            for b in range(n - a):
-                add(corner(a, b), corner(a + 1, b), corner(a, b + 1))
-                if a + b + 2 <= n:
-                    add(corner(a + 1, b), corner(a + 1, b + 1), corner(a, b + 1))
-    return points, triangles
+sys.path.insert(0, os.path.join(HERE, "..", "..", "meshes"))
+from generate_surfaces import octahedral_sphere  # noqa: E402
 
 
 def rotation(axis, angle):

@@ -605,6 +605,7 @@ bool Smoother::optimise(VertexId v) {
   const int steps = improving_ ? improving_->newton_steps
                     : tangled_ ? 2 * options_.newton_steps
                                : options_.newton_steps;
+  bool stalled = false;  // a Newton step found no acceptable point along its direction
   for (int step = 0; step < steps; ++step) {
     const double value = model.value;
     const Jacobian j = jacobian(v, at);
@@ -630,7 +631,10 @@ bool Smoother::optimise(VertexId v) {
       if (accepted && improving_)
         accepted = (worst_trial = worst(star, d)) <= worst_at && (guard_trial = worst(guard, d)) <= guard_at;
     }
-    if (!accepted) break;
+    if (!accepted) {
+      stalled = true;
+      break;
+    }
     const double moved = (trial.x - at.x).norm();
     at = trial;
     model = at_trial;
@@ -639,6 +643,46 @@ bool Smoother::optimise(VertexId v) {
       guard_at = std::max(guard_trial, 1.0 / improving_->threshold);
     }
     if (moved <= 1e-9 * length) break;
+  }
+  // Improving a surface node: Newton's model takes φ's derivative on one triangle of S in P. Where Floater's
+  // map squeezes part of S into a thin strip of P (a rim trimmed along S's triangles, with ears and rim
+  // chords: on Western Santa Cruz Island at E/50 an S_M node sat at v = 1.6e-7, φ's derivative 4.9e3 along u
+  // and 9.0e6 along v), its step leaves P or crosses into triangles whose derivatives differ by orders of
+  // magnitude, and the node stays where SUS left it however poor its star (a 2.8° tet there). So when a
+  // Newton step found nothing and the node made no headway, straight moves in P towards its S_M neighbours'
+  // parameters and their centroid are tried, and the one whose star's worst tet is best is taken if it
+  // lowers the objective, raises the worst tet and keeps the meccano guard, as a Newton step must.
+  if (improving_ && stalled && freedom_[v].kind == Freedom::surface && (at.x - start.x).norm() <= 1e-2 * length) {
+    const NodeFreedom& node = freedom_[v];
+    const SurfaceProjection& projection = *surfaces_[node.surface];
+    const auto& first = triangle_start_[node.surface];
+    std::vector<int> neighbours;
+    for (int k = first[node.index]; k < first[node.index + 1]; ++k)
+      for (const int w : projection.triangles[node_triangles_[node.surface][k]])
+        if (w != node.index) neighbours.push_back(w);
+    std::sort(neighbours.begin(), neighbours.end());
+    neighbours.erase(std::unique(neighbours.begin(), neighbours.end()), neighbours.end());
+    std::vector<Vector2d> targets;
+    Vector2d centroid = Vector2d::Zero();
+    for (const int w : neighbours) {
+      targets.push_back(projection.uv[w]);
+      centroid += projection.uv[w] / static_cast<double>(neighbours.size());
+    }
+    targets.push_back(centroid);
+    const Placement from = at;
+    double best_worst = worst_at;
+    for (const Vector2d& target : targets)
+      for (double fraction = 0.5; fraction > 0.01; fraction *= 0.5) {
+        Parameters step = Parameters::Zero();
+        step.head<2>() = fraction * (target - from.uv);
+        Placement trial;
+        if (!move(v, from, step, trial)) continue;
+        const Vector3d d = trial.x - start.x;
+        const double worst_trial = worst(star, d);
+        if (worst_trial >= best_worst || star_objective(star, d) >= model.value || worst(guard, d) > guard_at) continue;
+        at = trial;
+        best_worst = worst_trial;
+      }
   }
   const double moved = (at.x - start.x).norm();
   if (moved == 0.0) return false;

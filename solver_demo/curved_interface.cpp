@@ -28,6 +28,13 @@ meccano::DealiiMesh with_interface_on_surface(const meccano::DealiiMesh& mesh, c
   return moved;
 }
 
+void curve_cells_onto_surface(dealii::Triangulation<3>& triangulation, const meccano::DealiiInterface& interface,
+                              const SurfaceProjection& project) {
+  constexpr dealii::types::manifold_id curved = 0;
+  triangulation.set_all_manifold_ids(curved);
+  triangulation.set_manifold(curved, InterfaceEdgeManifold(interface, project));
+}
+
 InterfaceEdgeManifold::InterfaceEdgeManifold(const meccano::DealiiInterface& interface, SurfaceProjection project_)
     : project(std::move(project_)) {
   for (std::size_t t = 0; t < interface.triangles(); ++t)

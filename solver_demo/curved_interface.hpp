@@ -13,6 +13,8 @@
 //        support points (a cell, its faces and its lines must share one manifold id, checked in Debug),
 //        so every cell takes this manifold, and an edge of S_h is recognised by its two end points, which
 //        every cell around it shares.
+//        curve_cells_onto_surface: gives every cell, face and line of a triangulation that manifold (after
+//        the interface's faces have been found by their manifold id: this resets it).
 // Input  the interface's corners after with_interface_on_surface, so that they are the triangulation's
 //        vertices exactly.
 #pragma once
@@ -32,6 +34,9 @@ namespace solver_demo {
 
 meccano::DealiiMesh with_interface_on_surface(const meccano::DealiiMesh& mesh, const std::string& interface_name,
                                               const SurfaceProjection& project);
+
+void curve_cells_onto_surface(dealii::Triangulation<3>& triangulation, const meccano::DealiiInterface& interface,
+                              const SurfaceProjection& project);
 
 class InterfaceEdgeManifold : public dealii::Manifold<3> {
  public:

@@ -29,7 +29,6 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
-#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -139,9 +138,8 @@ void InterfacePoisson::make_grid(const meccano::DealiiMesh& input, const std::st
   every_rank.interfaces = Utilities::MPI::broadcast(communicator, mesh.interfaces, 0);
   const meccano::DealiiInterface& interface = every_rank.interface(interface_name);
   interface_faces = meccano::interface_cell_faces(triangulation, interface);
-  const types::manifold_id geometry = curved ? types::manifold_id(0) : numbers::flat_manifold_id;
-  triangulation.set_all_manifold_ids(geometry);
-  if (curved) triangulation.set_manifold(geometry, InterfaceEdgeManifold(interface, problem.exact_surface->project));
+  if (curved) curve_cells_onto_surface(triangulation, interface, problem.exact_surface->project);
+  else triangulation.set_all_manifold_ids(numbers::flat_manifold_id);
   report.curved = curved;
 
   double h = 0.0;
@@ -199,9 +197,10 @@ void InterfacePoisson::assemble_system() {
     fe_values.reinit(cell);
     cell_matrix = 0;
     cell_rhs = 0;
-    const double beta = problem.coefficient(cell->material_id());
+    const types::material_id material = cell->material_id();
+    const double beta = problem.coefficient(material);
     for (const unsigned int q : fe_values.quadrature_point_indices()) {
-      const double f = problem.right_hand_side(to_eigen(fe_values.quadrature_point(q)), cell->material_id());
+      const double f = problem.right_hand_side(to_eigen(fe_values.quadrature_point(q)), material);
       for (const unsigned int i : fe_values.dof_indices()) {
         for (const unsigned int j : fe_values.dof_indices())
           cell_matrix(i, j) += beta * fe_values.shape_grad(i, q) * fe_values.shape_grad(j, q) * fe_values.JxW(q);

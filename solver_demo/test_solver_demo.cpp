@@ -564,8 +564,7 @@ TEST_F(AdapterTest, CellsCurvedOntoTheSphereFillTheBall) {
     EXPECT_NEAR((to_eigen(p) - inclusion.centre).norm(), inclusion.radius, 1e-15);
   dealii::Triangulation<3> triangulation;
   meccano::create_triangulation(mesh, triangulation);
-  triangulation.set_all_manifold_ids(0);
-  triangulation.set_manifold(0, InterfaceEdgeManifold(mesh.interface(), project_onto_inclusion));
+  curve_cells_onto_surface(triangulation, mesh.interface(), project_onto_inclusion);
 
   const double ball = 4.0 / 3.0 * std::numbers::pi * std::pow(inclusion.radius, 3);
   std::array<double, 2> ball_error{};  // flat, curved
@@ -597,8 +596,7 @@ TEST_F(AdapterTest, CellsCurvedOntoTheCubeExampleFollowItsSurface) {
   dealii::Triangulation<3> triangulation;
   meccano::create_triangulation(mesh, triangulation);
   const auto faces = meccano::interface_cell_faces(triangulation, mesh.interface());
-  triangulation.set_all_manifold_ids(0);
-  triangulation.set_manifold(0, InterfaceEdgeManifold(mesh.interface(), project_onto_cube_example));
+  curve_cells_onto_surface(triangulation, mesh.interface(), project_onto_cube_example);
   std::array<double, 2> farthest{};  // flat, curved: the largest |z − s(x, y)| at the faces' quadrature points
   for (const unsigned int degree : {1u, 2u}) {
     const dealii::MappingFE<3> mapping(dealii::FE_SimplexP<3>{degree});

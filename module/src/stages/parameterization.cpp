@@ -547,18 +547,52 @@ void require_no_fold(const Connectivity& c, const Loop& loop, const std::array<i
   if (!fold.empty()) throw MeshingError(fold);
 }
 
-// Rim: chord-length spacing along each side; corner + t * (side direction) keeps the constant
-// coordinate exactly 0 or 1. Interior vertices are left NaN.
-std::vector<Vector2d> rim_on_square(const Connectivity& c, const Loop& loop, const std::array<int, 4>& p) {
-  const int n = loop.size();
+// A rim vertex pinned at perimeter coordinate `at`: the corners at 0, 1, 2, 3, anchors between them.
+struct Pin {
+  int position;  // in the loop
+  double at;
+};
+
+// The corners and anchors as pins in loop order, with the corner closing the loop at position N.
+// Throws std::invalid_argument if an anchor is not a rim vertex, is a corner, or breaks the order.
+std::vector<Pin> pins_along(const Connectivity& c, const Loop& loop, const std::array<int, 4>& p,
+                            std::span<const RimAnchor> anchors) {
+  std::vector<Pin> pins;
+  for (int k = 0; k < 4; ++k) pins.push_back({p[k], static_cast<double>(k)});
+  for (const RimAnchor& anchor : anchors) {
+    const int v = anchor.vertex >= 0 && anchor.vertex < static_cast<int>(c.local.size()) ? c.local[anchor.vertex] : -1;
+    if (v < 0 || loop.position[v] < 0 || !(anchor.at > 0.0 && anchor.at < 4.0))
+      throw std::invalid_argument("parameterize_to_square: anchor " + std::to_string(anchor.vertex) +
+                                  " is not a rim vertex with a perimeter coordinate in (0, 4)");
+    pins.push_back({loop.position[v], anchor.at});
+  }
+  std::ranges::sort(pins, {}, &Pin::position);
+  pins.push_back({loop.size(), 4.0});
+  for (std::size_t i = 0; i + 1 < pins.size(); ++i)
+    if (!(pins[i].position < pins[i + 1].position && pins[i].at < pins[i + 1].at))
+      throw std::invalid_argument("parameterize_to_square: the anchors and corners are not in one order along the "
+                                  "rim and the square's perimeter");
+  return pins;
+}
+
+// Rim: chord-length spacing between consecutive pins; every piece lies on one side k, and
+// corner + t * (side direction) keeps the side's constant coordinate exactly 0 or 1. Interior vertices
+// are left NaN.
+std::vector<Vector2d> rim_on_square(const Connectivity& c, const Loop& loop, const std::array<int, 4>& p,
+                                    std::span<const RimAnchor> anchors) {
   std::vector<Vector2d> uv(c.global.size(), Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
-  for (int k = 0; k < 4; ++k) {
-    const int end = k == 3 ? n : p[k + 1];
-    const double side_length = loop.length[end] - loop.length[p[k]];
-    if (!(side_length > 0.0))
-      throw MeshingError("parameterize_to_square: " + std::string(side_names[k]) + " has zero length");
-    for (int i = p[k]; i < end; ++i) {
-      const double t = (loop.length[i] - loop.length[p[k]]) / side_length;
+  const std::vector<Pin> pins = pins_along(c, loop, p, anchors);
+  for (std::size_t j = 0; j + 1 < pins.size(); ++j) {
+    const Pin& from = pins[j];
+    const Pin& to = pins[j + 1];
+    const int k = static_cast<int>(from.at);
+    const double arc = loop.length[to.position] - loop.length[from.position];
+    if (!(arc > 0.0))
+      throw MeshingError("parameterize_to_square: the rim between perimeter coordinates " + std::to_string(from.at) +
+                         " and " + std::to_string(to.at) + " on " + side_names[k] + " has zero length");
+    const double start = from.at - k, end = to.at - k;
+    for (int i = from.position; i < to.position; ++i) {
+      const double t = start + (end - start) * ((loop.length[i] - loop.length[from.position]) / arc);
       uv[loop.vertices[i]] = square_corners[k] + t * (square_corners[(k + 1) % 4] - square_corners[k]);
     }
   }
@@ -626,8 +660,16 @@ void require_one_to_one(const Connectivity& c, const std::vector<Vector2d>& uv, 
 
 }  // namespace
 
-SquareParameterization parameterize_to_square(DiskView disk, const std::array<int, 4>& corners,
-                                              FloaterWeights weights) {
+double perimeter_coordinate(const Vector2d& uv) {
+  if (uv.y() == 0.0 && uv.x() < 1.0) return uv.x();
+  if (uv.x() == 1.0 && uv.y() < 1.0) return 1.0 + uv.y();
+  if (uv.y() == 1.0 && uv.x() > 0.0) return 2.0 + (1.0 - uv.x());
+  if (uv.x() == 0.0 && uv.y() > 0.0) return 3.0 + (1.0 - uv.y());
+  throw std::invalid_argument("perimeter_coordinate: the point is not on the square's perimeter");
+}
+
+SquareParameterization parameterize_to_square(DiskView disk, const std::array<int, 4>& corners, FloaterWeights weights,
+                                              std::span<const RimAnchor> anchors) {
   const Connectivity c = connect(disk);
   require_four_rim_vertices(c);
   const std::vector<Vector3d> x = compact_points(c, disk);
@@ -636,7 +678,7 @@ SquareParameterization parameterize_to_square(DiskView disk, const std::array<in
   std::array<int, 4> p{};
   for (int k = 0; k < 4; ++k) p[k] = loop.position[c.local[corners[k]]];
   require_no_fold(c, loop, p);
-  std::vector<Vector2d> uv = rim_on_square(c, loop, p);
+  std::vector<Vector2d> uv = rim_on_square(c, loop, p, anchors);
   solve_interior(c, x, weights, uv);
   require_one_to_one(c, uv, direction);
 

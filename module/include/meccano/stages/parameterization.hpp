@@ -73,13 +73,28 @@ struct SquareParameterization {
   FloaterWeights weights = FloaterWeights::mean_value;
 };
 
+// A rim vertex placed at a given point of the square's perimeter, besides the corners: `at` is the
+// perimeter coordinate, k + t on side k (0 <= t < 1, see perimeter_coordinate). A surface clipped by the box
+// pins S_M's rim nodes where its rim passes from one box face to another, or into the box, at the
+// coordinates of the matching rim vertices of S, so that the arcs on each box face map onto each other.
+struct RimAnchor {
+  int vertex = -1;
+  double at = 0.0;
+};
+
+// Where on the square's perimeter a point of it lies: u on side 0 (v = 0), 1 + v on side 1 (u = 1),
+// 2 + (1 - u) on side 2 (v = 1), 3 + (1 - v) on side 3 (u = 0); corners give 0, 1, 2, 3.
+double perimeter_coordinate(const Eigen::Vector2d& uv);
+
 // Throws std::invalid_argument if the corners are not 4 distinct rim vertices met in this cyclic order
-// along the rim (either direction), MeshingError if an interior edge joins two vertices of one side (the
+// along the rim (either direction), or the anchors are not rim vertices whose coordinates increase with
+// the corners' along that walk; MeshingError if an interior edge joins two vertices of one side (the
 // message names the triangle when all three of its vertices are on that side), if the sparse solver
 // fails, or if a parametric triangle comes out flipped or flat (a rounding failure that the theorem above
-// excludes in exact arithmetic).
+// excludes in exact arithmetic). Between consecutive corners and anchors the rim is spaced by chord length.
 SquareParameterization parameterize_to_square(DiskView disk, const std::array<int, 4>& corners,
-                                              FloaterWeights weights = FloaterWeights::mean_value);
+                                              FloaterWeights weights = FloaterWeights::mean_value,
+                                              std::span<const RimAnchor> anchors = {});
 
 // Corners of one disk, in rim_loop's direction, for a rim with or without natural corners:
 //  1. corner 0 is `start` (a rim vertex id) or, for start = -1, the rim vertex with the largest turning

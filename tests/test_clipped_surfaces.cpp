@@ -1,0 +1,180 @@
+// Surfaces that reach the box boundary (issue 19, deliverable 1): clipped to the box
+// (surface/box_clipping.hpp) and inserted through the whole pipeline. The result must be a valid mesh
+// whose interface is a disk on S with its rim on S's rim: on the box faces exactly where S meets them,
+// with the box's nodes still on their planes, and covering S (its area is S's, exactly for a plane).
+
+#include <meccano/geometry/geometry.hpp>
+#include <meccano/mesh/cube_meccano.hpp>
+#include <meccano/mesh/invariants.hpp>
+#include <meccano/mesh/quality.hpp>
+#include <meccano/stages/pipeline.hpp>
+#include <meccano/surface/box_clipping.hpp>
+#include <meccano/surface/validation.hpp>
+
+#include <test_surfaces.hpp>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace meccano {
+namespace {
+
+const Box kUnitBox{Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()};
+
+// S clipped to the box: exactly one part expected.
+TriangleSurface clipped(const TriangleSurface& surface, const Box& box) {
+  std::vector<TriangleSurface> parts = clip_to_box(surface, box);
+  EXPECT_EQ(parts.size(), 1u);
+  return parts.front();
+}
+
+InsertionResult insert(const TriangleSurface& surface, const Box& box, double resolution) {
+  validate_surfaces({&surface, 1}, box);
+  InsertionOptions options;
+  options.resolution = resolution;
+  return insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
+}
+
+// The surface turned so that its z becomes x (a cyclic permutation of the axes: a rotation, so the
+// orientation is kept).
+TriangleSurface z_to_x(TriangleSurface surface) {
+  for (Eigen::Vector3d& p : surface.points) p = Eigen::Vector3d(p.z(), p.x(), p.y());
+  return surface;
+}
+
+double area(const std::vector<Eigen::Vector3d>& points, const std::vector<std::array<VertexId, 3>>& triangles) {
+  double sum = 0.0;
+  for (const auto& t : triangles) sum += 0.5 * (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]).norm();
+  return sum;
+}
+
+double area(const TriangleSurface& surface) {
+  std::vector<std::array<VertexId, 3>> triangles(surface.triangles.begin(), surface.triangles.end());
+  return area(surface.points, triangles);
+}
+
+// Every invariant of a clipped interface, for the only surface of `result`. `area_tolerance`: the share
+// of S's area the interface's flat faces may differ by (0 up to round-off for a plane).
+void expect_clipped_interface(const InsertionResult& result, const TriangleSurface& surface,
+                              double area_tolerance = 1e-9) {
+  const TetMesh& mesh = result.mesh;
+  ASSERT_TRUE(verify_mesh(mesh, {.physical = true}).ok()) << verify_mesh(mesh, {.physical = true}).summary();
+  EXPECT_EQ(count_inverted(mesh), 0);
+  ASSERT_TRUE(result.surfaces[0].rim_on_box);
+
+  // Every box node still on its planes, exactly: the box-side faces stay flat and tagged.
+  const GridPoint upper = mesh.meccano.upper_corner();
+  for (VertexId v = 0; v < mesh.num_vertices(); ++v)
+    for (int axis = 0; axis < 3; ++axis) {
+      if (mesh.grid[v][axis] == 0 || mesh.grid[v][axis] == upper[axis]) {
+        ASSERT_EQ(mesh.points[v][axis], mesh.meccano.to_physical(mesh.grid[v])[axis]) << "node " << v;
+      }
+    }
+
+  // A disk: one rim loop (every rim node in two rim edges), Euler characteristic 1.
+  const SurfaceInterface interface = surface_interfaces(result).front();
+  std::vector<std::array<VertexId, 3>> triangles;
+  for (const InterfaceFace& face : interface.faces) triangles.push_back(face.vertices);
+  std::map<std::pair<VertexId, VertexId>, int> edges;
+  std::vector<VertexId> vertices;
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      ++edges[std::minmax(t[k], t[(k + 1) % 3])];
+      vertices.push_back(t[k]);
+    }
+  std::ranges::sort(vertices);
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  EXPECT_EQ(static_cast<std::int64_t>(vertices.size()) - static_cast<std::int64_t>(edges.size()) +
+                static_cast<std::int64_t>(triangles.size()),
+            1);
+  std::map<VertexId, int> rim_degree;
+  for (const auto& [edge, uses] : edges) {
+    EXPECT_LE(uses, 2);
+    if (uses == 1) {
+      ++rim_degree[edge.first];
+      ++rim_degree[edge.second];
+    }
+  }
+
+  // On S; rim nodes on S's rim; the rim reaches the box: some rim nodes lie on it.
+  const TriangleBVH tree(surface);
+  const double tolerance = 1e-12 * mesh.meccano.box.diagonal();
+  for (VertexId v : vertices) EXPECT_LE(std::sqrt(tree.closest_point(mesh.points[v]).squared_distance), tolerance);
+  int rim_nodes_on_box = 0;
+  for (const auto& [v, degree] : rim_degree) {
+    EXPECT_EQ(degree, 2) << "rim node " << v << " is pinched";
+    EXPECT_LE(testing::distance_to_rim(surface, mesh.points[v]), tolerance) << "rim node " << v;
+    rim_nodes_on_box += box_sides(mesh.points[v], mesh.meccano.box) != 0;
+  }
+  EXPECT_GT(rim_nodes_on_box, 0);
+  EXPECT_NEAR(area(mesh.points, triangles), area(surface), area_tolerance * area(surface) + tolerance);
+
+  // Quality of the order the disks of the tests get.
+  EXPECT_GT(result.quality_after_smoothing.equilateral.min, 0.1);
+  EXPECT_GT(result.quality_after_smoothing.min_dihedral_deg, 5.0);
+}
+
+// Planes across the box along each axis: the interface divides the box, its rim runs round four faces.
+TEST(ClippedSurface, APlaneAcrossTheBoxAlongEachAxis) {
+  const TriangleSurface plane =
+      clipped(testing::graph_patch([](double, double) { return 0.5; }, {-0.3, 1.3}, {-0.3, 1.3}, 16, "plane"),
+              kUnitBox);
+  for (int turns = 0; turns < 3; ++turns) {
+    SCOPED_TRACE(turns);
+    TriangleSurface turned = plane;
+    for (int k = 0; k < turns; ++k) turned = z_to_x(turned);
+    expect_clipped_interface(insert(turned, kUnitBox, 0.08), turned);
+  }
+}
+
+// An oblique plane through four faces, and one cutting off a corner of the box (three faces, three
+// box edges).
+TEST(ClippedSurface, ObliquePlanes) {
+  const TriangleSurface oblique = clipped(
+      testing::graph_patch([](double x, double y) { return 0.3 + 0.35 * x + 0.1 * y; }, {-0.3, 1.3}, {-0.3, 1.3}, 16),
+      kUnitBox);
+  EXPECT_NEAR(area(oblique), std::sqrt(1.0 + 0.35 * 0.35 + 0.1 * 0.1), 1e-12);
+  expect_clipped_interface(insert(oblique, kUnitBox, 0.08), oblique);
+
+  const TriangleSurface corner = clipped(
+      testing::graph_patch([](double x, double y) { return 0.6 - x - y; }, {-0.3, 0.9}, {-0.3, 0.9}, 16), kUnitBox);
+  EXPECT_NEAR(area(corner), std::sqrt(3.0) / 4.0 * 0.72, 1e-12);
+  expect_clipped_interface(insert(corner, kUnitBox, 0.06), corner);
+}
+
+// A curved sheet across the box, in a box that is not a cube.
+TEST(ClippedSurface, AWavySheetAcrossANonCubicBox) {
+  const Box box{Eigen::Vector3d::Zero(), Eigen::Vector3d(2.0, 1.0, 1.0)};
+  const TriangleSurface sheet =
+      clipped(testing::graph_patch([](double x, double y) { return 0.5 + 0.1 * std::sin(3 * x) * std::cos(2 * y); },
+                                   {-0.3, 2.3}, {-0.3, 1.3}, 30, "sheet"),
+              box);
+  expect_clipped_interface(insert(sheet, box, 0.08), sheet, 0.01);
+}
+
+// Faults, near vertical, that reach the box top only, the top and one side (through a box edge), and
+// three faces.
+TEST(ClippedSurface, FaultsLeavingThroughOneTwoAndThreeFaces) {
+  const auto fault = [](std::array<double, 2> y_range, std::array<double, 2> z_range) {
+    // x = 0.45 + 0.1 z + 0.03 sin(5 y), over y_range x z_range: a graph over (y, z), turned.
+    return z_to_x(testing::graph_patch([](double y, double z) { return 0.45 + 0.1 * z + 0.03 * std::sin(5 * y); },
+                                       y_range, z_range, 24, "fault"));
+  };
+  // graph_patch's (x, y, f) becomes (f, x, y): y_range runs along y, z_range along z.
+  for (const auto& [y_range, z_range] : std::vector<std::pair<std::array<double, 2>, std::array<double, 2>>>{
+           {{0.2, 0.8}, {0.3, 1.2}}, {{0.3, 1.2}, {0.3, 1.2}}, {{-0.2, 1.2}, {0.3, 1.2}}}) {
+    SCOPED_TRACE(y_range[0]);
+    const TriangleSurface surface = clipped(fault(y_range, z_range), kUnitBox);
+    expect_clipped_interface(insert(surface, kUnitBox, 0.07), surface, 0.01);
+  }
+}
+
+}  // namespace
+}  // namespace meccano

@@ -488,14 +488,16 @@ TEST_F(CliTest, AFailureAfterRetriesListsEachAttemptOnOneLine) {
 
 TEST_F(CliTest, BadSurfacesFailWithTheirOwnMessageAndWriteNothing) {
   const TriangleSurface patch = testing::paper_like_patch(6);
+  // A surface that crosses the box is clipped to it; one wholly outside has nothing to insert, and one
+  // whose rim touches the box at a point cannot be followed there.
   TriangleSurface outside = patch;
-  outside.points[0].z() = 1.5;
+  for (Eigen::Vector3d& p : outside.points) p.z() += 1.5;
   TriangleSurface on_boundary = patch;
   on_boundary.points[0].x() = 0.0;
   TriangleSurface flipped = patch;
   std::swap(flipped.triangles[3][0], flipped.triangles[3][1]);
   const std::map<std::string, std::pair<TriangleSurface, std::string>> cases{
-      {"outside.obj", {outside, "outside the box"}},
+      {"outside.obj", {outside, "no part of the surface lies inside the box"}},
       {"boundary.obj", {on_boundary, "on the box boundary"}},
       {"flipped.obj", {flipped, "orientation"}},
   };

@@ -123,9 +123,8 @@ void expect_clipped_interface(const InsertionResult& result, const TriangleSurfa
 
 // Planes across the box along each axis: the interface divides the box, its rim runs round four faces.
 TEST(ClippedSurface, APlaneAcrossTheBoxAlongEachAxis) {
-  const TriangleSurface plane =
-      clipped(testing::graph_patch([](double, double) { return 0.5; }, {-0.3, 1.3}, {-0.3, 1.3}, 16, "plane"),
-              kUnitBox);
+  const TriangleSurface plane = clipped(
+      testing::graph_patch([](double, double) { return 0.5; }, {-0.3, 1.3}, {-0.3, 1.3}, 16, "plane"), kUnitBox);
   for (int turns = 0; turns < 3; ++turns) {
     SCOPED_TRACE(turns);
     TriangleSurface turned = plane;

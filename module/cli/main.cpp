@@ -13,6 +13,7 @@
 #include <meccano/report/quality_csv.hpp>
 #include <meccano/stages/pipeline.hpp>
 #include <meccano/stages/sequence.hpp>
+#include <meccano/surface/box_clipping.hpp>
 #include <meccano/surface/validation.hpp>
 
 #include "arguments.hpp"
@@ -424,6 +425,23 @@ std::vector<meccano::TriangleSurface> read_surfaces(const std::vector<std::pair<
   return surfaces;
 }
 
+// Surfaces that reach the box boundary clipped to the box: the part inside, each of its disks a surface.
+std::vector<meccano::TriangleSurface> clipped_to_box(std::vector<meccano::TriangleSurface> surfaces,
+                                                     const meccano::Box& box, const Progress& progress) {
+  std::vector<meccano::TriangleSurface> inside;
+  for (meccano::TriangleSurface& surface : surfaces) {
+    if (!meccano::reaches_box(surface, box)) {
+      inside.push_back(std::move(surface));
+      continue;
+    }
+    for (meccano::TriangleSurface& part : meccano::clip_to_box(surface, box)) {
+      progress.say("surface ", part.name, ": clipped by the box, ", part.triangles.size(), " triangles inside");
+      inside.push_back(std::move(part));
+    }
+  }
+  return inside;
+}
+
 // The cells of the box's meccano, once its tet count is known to be within --max-tets.
 std::array<int, 3> meccano_cells(const Options& options, const Progress& progress) {
   const auto cells = options.cells ? *options.cells : meccano::cells_for_box(options.box);
@@ -460,9 +478,10 @@ int run(const Options& options) {
   if (options.threads) omp_set_num_threads(*options.threads);
   const auto cells = meccano_cells(options, progress);
   // Read and validate every surface before any meshing: bad input must not cost a meshing run.
-  std::vector<meccano::TriangleSurface> surfaces = read_surfaces(options.surfaces, options, progress);
+  std::vector<meccano::TriangleSurface> surfaces =
+      clipped_to_box(read_surfaces(options.surfaces, options, progress), options.box, progress);
   meccano::validate_surfaces(surfaces, options.box);
-  if (!surfaces.empty()) progress.say("surfaces valid: open disks, inside the box, disjoint");
+  if (!surfaces.empty()) progress.say("surfaces valid: disks and spheres, inside the box, disjoint");
 
   meccano::TetMesh mesh = meccano::make_cube_meccano(options.box, cells, options.level);
   progress.say("meccano: ", mesh.num_tets(), " tets, ", mesh.num_vertices(), " nodes");
@@ -604,7 +623,8 @@ int run_sequence(const std::vector<std::string>& args) {
   std::vector<std::vector<meccano::TriangleSurface>> surfaces;
   for (int k = 0; k < steps; ++k) {
     try {
-      surfaces.push_back(read_surfaces(parsed.steps[k], options, Progress(true)));
+      surfaces.push_back(
+          clipped_to_box(read_surfaces(parsed.steps[k], options, Progress(true)), options.box, Progress(true)));
       meccano::validate_surfaces(surfaces.back(), options.box);
     } catch (const meccano::InputError& error) {
       throw meccano::InputError("step " + std::to_string(k) + ": " + error.what());

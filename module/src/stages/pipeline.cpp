@@ -4,6 +4,7 @@
 #include <meccano/geometry/geometry.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/mesh/invariants.hpp>
+#include <meccano/surface/box_clipping.hpp>
 #include <meccano/surface/closed_surface.hpp>
 #include <meccano/surface/rim_chords.hpp>
 
@@ -155,6 +156,7 @@ void approximate_volumes(InsertionResult& result, std::span<const TriangleSurfac
     SurfaceInsertion& inserted = result.surfaces.emplace_back();
     inserted.name = surface.name;
     inserted.closed = is_closed(surface);
+    inserted.rim_on_box = reaches_box(surface, result.mesh.meccano.box);
     inserted.resolution = resolutions[index];
     std::vector<TetRegion*> earlier;
     for (int s = 0; s < index; ++s) earlier.push_back(&result.surfaces[s].volumetric);
@@ -199,14 +201,17 @@ void approximate_surfaces(InsertionResult& result, std::span<const TriangleSurfa
   for (int round = 0; round < 3; ++round) {
     bool healed_any = false;
     for (int s = 0; s < count; ++s) {
-      if (round > 0 && check_surface_approximation(result.mesh, result.surfaces[s].volumetric, s).healed()) continue;
+      const SurfaceInsertion& inserted = result.surfaces[s];
+      if (round > 0 && check_surface_approximation(result.mesh, inserted.volumetric, s, inserted.rim_on_box).healed())
+        continue;
       heal_surface(result, s, surfaces[s], trees[s], options, side_rules[s]);
       healed_any = true;
     }
     if (!healed_any) break;
   }
   for (int s = 0; s < count; ++s) {
-    const auto check = check_surface_approximation(result.mesh, result.surfaces[s].volumetric, s);
+    const auto check =
+        check_surface_approximation(result.mesh, result.surfaces[s].volumetric, s, result.surfaces[s].rim_on_box);
     if (!check.healed())
       throw SurfaceFailure({s}, "the surface approximation of " + result.surfaces[s].name +
                                     " is disturbed by the other surfaces: " + check.describe());
@@ -848,9 +853,13 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
   if (surfaces.size() != previous.surfaces.size())
     throw InputError(std::to_string(surfaces.size()) + " surfaces to move, but the previous step inserted " +
                      std::to_string(previous.surfaces.size()));
-  for (const TriangleSurface& surface : surfaces)
+  for (const TriangleSurface& surface : surfaces) {
     if (is_closed(surface))
       throw InputError(surface.name + ": moving a closed surface is not supported yet; insert each step anew");
+    if (reaches_box(surface, previous.mesh.meccano.box))
+      throw InputError(surface.name + ": moving a surface clipped by the box is not supported yet; insert each "
+                                      "step anew");
+  }
   const ThreadCount threads(options.threads);
   InsertionResult result;
   result.mesh = previous.mesh;

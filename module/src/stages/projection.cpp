@@ -3,6 +3,7 @@
 #include <meccano/error.hpp>
 #include <meccano/mesh/quality.hpp>
 #include <meccano/stages/surface_approximation.hpp>
+#include <meccano/surface/box_clipping.hpp>
 #include <meccano/surface/closed_surface.hpp>
 #include <meccano/surface/rim_chords.hpp>
 
@@ -10,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -94,12 +96,13 @@ RimGap require_rim_covered(const TriangleSurface& surface, std::span<const int> 
 // The S_M nodes (sorted), their parameters and rim flags from S_M's own parameterization, and S_M's
 // triangles over them.
 void take_parameters(SurfaceProjection& result, std::span<const std::array<int, 3>> triangles,
-                     const SquareParameterization& own, std::size_t mesh_points) {
+                     const SquareParameterization& own, std::span<const RimAnchor> anchors, std::size_t mesh_points) {
   for (const auto& t : triangles) result.nodes.insert(result.nodes.end(), t.begin(), t.end());
   std::sort(result.nodes.begin(), result.nodes.end());
   result.nodes.erase(std::unique(result.nodes.begin(), result.nodes.end()), result.nodes.end());
   std::vector<std::uint8_t> rim(mesh_points, 0);
   for (int v : own.rim) rim[v] = 1;
+  for (const RimAnchor& anchor : anchors) rim[anchor.vertex] = pinned_rim_node;
   result.uv.resize(result.nodes.size());
   result.on_rim.resize(result.nodes.size());
   for (std::size_t i = 0; i < result.nodes.size(); ++i) {
@@ -122,8 +125,12 @@ void move_nodes_onto_surface(TetMesh& mesh, SurfaceProjection& result, const Tri
   std::vector<Eigen::Vector3d> moved(result.nodes.size());
 #pragma omp parallel for schedule(dynamic, 256)
   for (std::int64_t i = 0; i < count; ++i) moved[i] = result.surface->evaluate(result.surface->locate(result.uv[i]));
+  const GridPoint upper = mesh.meccano.upper_corner();
   for (std::int64_t i = 0; i < count; ++i) {
     const VertexId v = result.nodes[i];
+    // A rim node on the box lands on S's rim on the same box planes: keep its coordinates there exact.
+    for (int axis = 0; axis < 3; ++axis)
+      if (mesh.grid[v][axis] == 0 || mesh.grid[v][axis] == upper[axis]) moved[i][axis] = mesh.points[v][axis];
     stats.largest_move = std::max(stats.largest_move, (moved[i] - mesh.points[v]).norm());
     mesh.points[v] = moved[i];
     stats.largest_distance_after =
@@ -132,24 +139,155 @@ void move_nodes_onto_surface(TetMesh& mesh, SurfaceProjection& result, const Tri
   stats.nodes = count;
 }
 
-// One disk of S_M (`triangles`, over the mesh's numbering, oriented like S) onto one disk of S (`target`),
-// with the corners given for both: steps 1-3 once the corners are chosen. `pulled` holds S_M's nodes
-// pulled towards S.
+// One disk of S_M (`triangles`, over the mesh's numbering, oriented like S) onto one disk of S (`target`,
+// parameterized), with S_M's corners and anchors given: steps 1-3 once the corners are chosen. `pulled`
+// holds S_M's nodes pulled towards S.
 SurfaceProjection project_disk(TetMesh& mesh, std::span<const std::array<int, 3>> triangles,
-                               const TriangleSurface& target, const std::array<int, 4>& target_corners,
+                               const TriangleSurface& target, SquareParameterization target_parameterization,
                                const std::vector<Eigen::Vector3d>& pulled, const std::array<int, 4>& own_corners,
-                               const TriangleBVH& tree, const ProjectionOptions& options) {
+                               std::span<const RimAnchor> own_anchors, const TriangleBVH& tree,
+                               const ProjectionOptions& options) {
   SurfaceProjection result;
-  result.surface =
-      std::make_unique<ParametricSurface>(target, parameterize_to_square(target, target_corners, options.weights));
-  const SquareParameterization own = parameterize_to_square(DiskView(pulled, triangles), own_corners, options.weights);
-  take_parameters(result, triangles, own, mesh.points.size());
+  result.surface = std::make_unique<ParametricSurface>(target, std::move(target_parameterization));
+  const SquareParameterization own =
+      parameterize_to_square(DiskView(pulled, triangles), own_corners, options.weights, own_anchors);
+  take_parameters(result, triangles, own, own_anchors, mesh.points.size());
   result.creases = follow_creases(crease_lines(target, result.surface->parameterization().uv, options.crease_angle),
                                   result.triangles, result.uv, result.on_rim, result.orientation);
   result.stats.creases = result.creases.stats;
   move_nodes_onto_surface(mesh, result, tree);
   result.stats.rim_nodes = static_cast<std::int64_t>(own.rim.size());
   return result;
+}
+
+// Where a rim runs on the box. The label of a rim edge is the set of box planes both its ends lie on (0
+// inside the box); an arc is a maximal run of edges with one label, and a transition the rim vertex where
+// one arc ends and the next begins. A surface clipped by the box has its transitions where its rim passes
+// from one box face to the next (on a box edge) or into the box.
+struct BoxArcs {
+  std::vector<int> start;           // loop positions of the transitions, increasing
+  std::vector<std::uint8_t> label;  // of the arc that begins there; one label and no start for a uniform rim
+  bool on_box() const { return label.size() > 1 || label.front() != 0; }
+};
+
+// `planes`: the box planes of each rim vertex, in loop order. Throws MeshingError, naming the vertex
+// through `name`, where the rim touches the box planes at a vertex whose rim edges do not run on them:
+// such a node would have to stay on the box and follow the rim of S inside it.
+BoxArcs box_arcs(std::span<const std::uint8_t> planes, const std::function<std::string(int)>& name) {
+  const int n = static_cast<int>(planes.size());
+  const auto label = [&](int i) { return static_cast<std::uint8_t>(planes[i] & planes[(i + 1) % n]); };
+  BoxArcs arcs;
+  for (int i = 0; i < n; ++i) {
+    const std::uint8_t in = label((i + n - 1) % n), out = label(i);
+    if ((in | out) != planes[i])
+      throw MeshingError("the rim of " + name(i) + " touches the box where its rim edges do not run on it");
+    if (in != out) {
+      arcs.start.push_back(i);
+      arcs.label.push_back(out);
+    }
+  }
+  if (arcs.start.empty()) arcs.label.push_back(label(0));
+  return arcs;
+}
+
+std::uint8_t grid_box_planes(const TetMesh& mesh, VertexId v) {
+  const GridPoint upper = mesh.meccano.upper_corner();
+  std::uint8_t planes = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (mesh.grid[v][axis] == 0) planes |= static_cast<std::uint8_t>(1u << (2 * axis));
+    if (mesh.grid[v][axis] == upper[axis]) planes |= static_cast<std::uint8_t>(1u << (2 * axis + 1));
+  }
+  return planes;
+}
+
+std::string describe_labels(std::span<const std::uint8_t> labels) {
+  std::string text;
+  for (std::uint8_t label : labels) text += (text.empty() ? "" : ", ") + std::to_string(label);
+  return text;
+}
+
+// S_M's corners and anchors for an S whose rim runs on the box (at least one transition): S_M's arcs are
+// matched to S's (same labels in the same cyclic order, the rotation whose transitions lie nearest to
+// S's), every transition of S_M is pinned at its partner's perimeter coordinate (a corner where that is
+// one of S's corners), and S's other corners go to the S_M rim node at the same share of the chord length
+// of the matched arc.
+struct MatchedRim {
+  std::array<int, 4> corners{};
+  std::vector<RimAnchor> anchors;
+};
+
+MatchedRim match_box_arcs(const TriangleSurface& surface, std::span<const int> surface_rim, const BoxArcs& surface_arcs,
+                          const SquareParameterization& surface_parameterization, const TetMesh& mesh,
+                          std::span<const int> rim, const BoxArcs& arcs) {
+  const int m = static_cast<int>(surface_arcs.start.size());
+  if (static_cast<int>(arcs.start.size()) != m)
+    throw MeshingError("the rim of S_M runs on the box in " + std::to_string(arcs.start.size()) +
+                       " arcs where S's runs in " + std::to_string(m) + " (box planes of S's arcs: " +
+                       describe_labels(surface_arcs.label) + "; of S_M's: " + describe_labels(arcs.label) + ")");
+  int rotation = -1;
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < m; ++r) {
+    double cost = 0.0;
+    for (int j = 0; j < m && cost < best; ++j)
+      cost =
+          surface_arcs.label[j] != arcs.label[(j + r) % m]
+              ? std::numeric_limits<double>::infinity()
+              : cost + (surface.points[surface_rim[surface_arcs.start[j]]] - mesh.points[rim[arcs.start[(j + r) % m]]])
+                           .norm();
+    if (cost < best) {
+      best = cost;
+      rotation = r;
+    }
+  }
+  if (rotation < 0)
+    throw MeshingError("the rim of S_M meets the box faces in another order than S's rim (box planes of S's arcs: " +
+                       describe_labels(surface_arcs.label) + "; of S_M's: " + describe_labels(arcs.label) + ")");
+
+  const int n = static_cast<int>(rim.size());
+  std::vector<double> length(1, 0.0);  // chord length along S_M's rim from position 0, closing the loop
+  for (int i = 0; i < n; ++i)
+    length.push_back(length.back() + (mesh.points[rim[(i + 1) % n]] - mesh.points[rim[i]]).norm());
+  const auto arc_length = [&](int from, int to) {
+    return to >= from ? length[to] - length[from] : length[n] - length[from] + length[to];
+  };
+  std::vector<double> at(m);
+  for (int j = 0; j < m; ++j)
+    at[j] = perimeter_coordinate(surface_parameterization.uv[surface_rim[surface_arcs.start[j]]]);
+
+  // Perimeter from coordinate a forward to b; S's transitions need not start at its corner 0.
+  const auto forward = [](double a, double b) { return b >= a ? b - a : b - a + 4.0; };
+  MatchedRim matched;
+  std::array<int, 4> position{};  // of each corner along S_M's rim
+  for (int k = 0; k < 4; ++k) {
+    int j = 0;  // the arc of S holding corner k
+    while (!(forward(at[j], k) < forward(at[j], at[(j + 1) % m]))) ++j;
+    const int from = arcs.start[(j + rotation) % m], to = arcs.start[(j + 1 + rotation) % m];
+    if (at[j] == k) {
+      position[k] = from;
+      continue;
+    }
+    const double share = forward(at[j], k) / forward(at[j], at[(j + 1) % m]);
+    const double whole = arc_length(from, to);
+    const auto miss = [&](int i) { return std::abs(arc_length(from, i) / whole - share); };
+    int nearest = -1;
+    for (int i = (from + 1) % n; i != to; i = (i + 1) % n)
+      if (nearest < 0 || miss(i) < miss(nearest)) nearest = i;
+    if (nearest < 0)
+      throw MeshingError("an arc of S_M's rim on the box has no node for corner " + std::to_string(k) +
+                         " of the square");
+    position[k] = nearest;
+  }
+  double previous = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    matched.corners[k] = rim[position[k]];
+    const double along = arc_length(position[0], position[k]);
+    if (k > 0 && !(along > previous))
+      throw MeshingError("two corners of the square fall on one node of S_M's rim, or out of order");
+    previous = along;
+  }
+  for (int j = 0; j < m; ++j)
+    if (at[j] != std::floor(at[j])) matched.anchors.push_back({rim[arcs.start[(j + rotation) % m]], at[j]});
+  return matched;
 }
 
 // The triangles of S_M, oriented like S, over the mesh's numbering.
@@ -274,16 +412,43 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
   const std::vector<int> surface_rim = rim_loop(target);
   const double gap = require_rim_covered(surface, surface_rim, mesh.points, triangles, options.max_rim_gap).distance;
 
-  // Matching corners: S's by arc length, S_M's nearest to them around the same mean normal.
+  // Both rims, walked the same way round S's mean normal, and where they run on the box.
   const std::vector<Eigen::Vector3d> pulled = pulled_towards_surface(mesh, triangles, tree);
-  const auto surface_corners = corners_by_arc_length(target);
   const Eigen::Vector3d normal = vector_area(surface.points, surface_rim);
-  std::array<Eigen::Vector3d, 4> targets;
-  for (int k = 0; k < 4; ++k) targets[k] = surface.points[surface_corners[k]];
-  const auto approximation_corners = matching_corners(DiskView(pulled, triangles), targets, normal);
+  std::vector<int> rim = rim_loop(DiskView(pulled, triangles));
+  if (vector_area(pulled, rim).dot(normal) < 0.0) std::ranges::reverse(rim);
+  std::vector<std::uint8_t> planes;
+  for (int v : surface_rim) planes.push_back(box_sides(surface.points[v], mesh.meccano.box));
+  const BoxArcs surface_arcs =
+      box_arcs(planes, [&](int i) { return "S at its vertex " + std::to_string(surface_rim[i] + 1); });
+  planes.clear();
+  for (int v : rim) planes.push_back(grid_box_planes(mesh, v));
+  const BoxArcs arcs = box_arcs(planes, [&](int i) { return "S_M at node " + std::to_string(rim[i]); });
 
-  SurfaceProjection result =
-      project_disk(mesh, triangles, surface, surface_corners, pulled, approximation_corners, tree, options);
+  std::array<int, 4> surface_corners{}, approximation_corners{};
+  std::vector<RimAnchor> anchors;
+  std::optional<SquareParameterization> surface_parameterization;
+  if (!surface_arcs.start.empty()) {
+    // S clipped by the box: the arcs on each box face map onto each other, their ends pinned.
+    surface_corners = corners_by_arc_length(target, surface_rim[surface_arcs.start.front()]);
+    surface_parameterization = parameterize_to_square(target, surface_corners, options.weights);
+    MatchedRim matched = match_box_arcs(surface, surface_rim, surface_arcs, *surface_parameterization, mesh, rim, arcs);
+    approximation_corners = matched.corners;
+    anchors = std::move(matched.anchors);
+  } else {
+    // A rim inside the box, or all of it on one box face: S's corners by arc length, S_M's nearest to them.
+    if (surface_arcs.label.front() != arcs.label.front() || !arcs.start.empty())
+      throw MeshingError("the rim of S_M runs on the box where S's does not (box planes of S's rim: " +
+                         describe_labels(surface_arcs.label) + "; of S_M's arcs: " + describe_labels(arcs.label) + ")");
+    surface_corners = corners_by_arc_length(target);
+    surface_parameterization = parameterize_to_square(target, surface_corners, options.weights);
+    std::array<Eigen::Vector3d, 4> targets;
+    for (int k = 0; k < 4; ++k) targets[k] = surface.points[surface_corners[k]];
+    approximation_corners = matching_corners(DiskView(pulled, triangles), targets, normal);
+  }
+
+  SurfaceProjection result = project_disk(mesh, triangles, surface, std::move(*surface_parameterization), pulled,
+                                          approximation_corners, anchors, tree, options);
   result.surface_index = index;
   result.stats.rim_gap = gap;
   result.stats.inverted_tets = count_inverted(mesh);
@@ -306,8 +471,9 @@ std::vector<SurfaceProjection> project_closed_onto_surface(TetMesh& mesh, const 
 
   std::vector<SurfaceProjection> halves;
   for (int half = 0; half < 2; ++half)
-    halves.push_back(project_disk(mesh, cut.approximation[half], cut.surface[half], surface_corners, pulled,
-                                  approximation_corners, tree, options));
+    halves.push_back(project_disk(mesh, cut.approximation[half], cut.surface[half],
+                                  parameterize_to_square(cut.surface[half], surface_corners, options.weights), pulled,
+                                  approximation_corners, {}, tree, options));
   const std::int64_t inverted = count_inverted(mesh);
   for (SurfaceProjection& half : halves) {
     half.surface_index = index;

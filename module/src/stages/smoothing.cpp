@@ -354,7 +354,10 @@ void Smoother::classify_nodes() {
       for (int i : projection.triangles[t]) node_triangles_[s][fill[i]++] = t;
     for (int i = 0; i < static_cast<int>(projection.nodes.size()); ++i) {
       NodeFreedom& node = freedom_[projection.nodes[i]];
-      if (node.kind != Freedom::space) {  // on the box or on another surface: cannot follow both
+      // On another surface, or on the box off a rim that runs there: cannot follow both. A rim node on
+      // the box slides along S's rim, which runs on the same box planes (stages/projection.hpp, "Box").
+      const bool slides_on_box = node.kind == Freedom::box && projection.on_rim[i] == 1;
+      if (node.kind != Freedom::space && !slides_on_box) {
         node.kind = Freedom::fixed;
         continue;
       }
@@ -371,7 +374,7 @@ void Smoother::classify_nodes() {
       const Vector2d& uv = projection.uv[i];
       const bool u_on_side = uv.x() == 0.0 || uv.x() == 1.0;
       const bool v_on_side = uv.y() == 0.0 || uv.y() == 1.0;
-      node.kind = u_on_side && v_on_side ? Freedom::fixed : Freedom::rim;
+      node.kind = (u_on_side && v_on_side) || projection.on_rim[i] == pinned_rim_node ? Freedom::fixed : Freedom::rim;
       node.rim_axis = u_on_side ? 1 : 0;
     }
   }
@@ -563,6 +566,8 @@ bool Smoother::move(VertexId v, const Placement& from, const Parameters& step, P
   const auto location = surface.locate(to.uv, from.triangle);
   to.triangle = location.triangle;
   to.x = surface.evaluate(location);
+  for (int axis = 0; axis < 3; ++axis)  // a rim node on the box keeps its coordinates there exact
+    if (!(node.free_axes & (1u << axis))) to.x[axis] = from.x[axis];
   return true;
 }
 

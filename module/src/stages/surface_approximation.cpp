@@ -1,4 +1,5 @@
 #include <meccano/stages/surface_approximation.hpp>
+#include <meccano/surface/box_clipping.hpp>
 #include <meccano/surface/closed_surface.hpp>
 
 #include <meccano/error.hpp>
@@ -334,7 +335,9 @@ struct EdgeDefects {
   std::int64_t unfixable_nodes = 0;  // S_M nodes on the box or on another S_M themselves
 };
 
-EdgeDefects find_edge_defects(const TetMesh& mesh, const Interface& s, const VertexTets& incidence) {
+// `rim_on_box`: S is clipped by the box, so S_M's rim nodes may lie on it (stages/projection.hpp, "Box"),
+// and edges from S_M to box nodes are the neighbourhood of that rim, not defects.
+EdgeDefects find_edge_defects(const TetMesh& mesh, const Interface& s, const VertexTets& incidence, bool rim_on_box) {
   EdgeDefects d;
   auto is_interface_edge = [&](VertexId a, VertexId b) {
     bool found = false;
@@ -343,12 +346,12 @@ EdgeDefects find_edge_defects(const TetMesh& mesh, const Interface& s, const Ver
   };
   for (VertexId a = 0; a < mesh.num_vertices(); ++a) {
     if (!s.on_interface[a]) continue;
-    const bool a_elsewhere = on_box_boundary(mesh, a) || s.on_other_interface[a];
+    const bool a_elsewhere = (on_box_boundary(mesh, a) && !(rim_on_box && s.on_rim[a])) || s.on_other_interface[a];
     d.unfixable_nodes += a_elsewhere;
     for (TetId t : incidence.of(a))
       for (VertexId b : mesh.tets[t]) {
         if (b == a) continue;
-        if (!a_elsewhere && (on_box_boundary(mesh, b) || s.on_other_interface[b]))
+        if (!a_elsewhere && ((!rim_on_box && on_box_boundary(mesh, b)) || s.on_other_interface[b]))
           d.cross_surface.push_back(make_edge(a, b));
         if (a > b || !s.on_interface[b]) continue;
         if (s.on_rim[a] && s.on_rim[b]) {
@@ -429,14 +432,14 @@ void check_disk(const TetMesh& mesh, const Interface& s, SurfaceApproximationChe
   for (const Edge& e : s.rim_edges) c.oblique_rim_edges += !edge_is_axis_parallel(mesh, e.first, e.second);
 }
 
-SurfaceApproximationCheck inspect(const TetMesh& mesh, const Interface& s) {
+SurfaceApproximationCheck inspect(const TetMesh& mesh, const Interface& s, bool rim_on_box) {
   SurfaceApproximationCheck c;
   check_disk(mesh, s, c);
   c.corbels = static_cast<std::int64_t>(find_corbels(s).size() / 2);
   c.reflex_rim_corners = static_cast<std::int64_t>(reflex_rim_corners(mesh, s).size());
   c.tets_with_two_faces = static_cast<std::int64_t>(tets_with_two_faces(mesh, s).size());
   c.triangles_with_two_rim_edges = static_cast<std::int64_t>(triangles_with_two_rim_edges(mesh, s).size());
-  const EdgeDefects defects = find_edge_defects(mesh, s, vertex_to_tets(mesh));
+  const EdgeDefects defects = find_edge_defects(mesh, s, vertex_to_tets(mesh), rim_on_box);
   c.cross_surface_edges = static_cast<std::int64_t>(defects.cross_surface.size());
   c.dividing_edges = static_cast<std::int64_t>(defects.dividing.size());
   c.chord_edges = static_cast<std::int64_t>(defects.chords.size());
@@ -478,10 +481,15 @@ std::vector<FaceRef> missing_squares_at(const TetMesh& mesh, const TetRegion& vo
 // would add to S_M a ragged lip that healing then has to erode.
 class SideClassifier {
  public:
-  SideClassifier(const TriangleSurface& surface, const TriangleBVH& tree) : surface_(surface), tree_(tree) {
+  // Where S is clipped by the box, its rim edges on the box are no rim for this purpose: S went on beyond
+  // the box, and the nodes of V_M beside them, on the box, have the side of S's normal there.
+  SideClassifier(const TriangleSurface& surface, const TriangleBVH& tree, const Box& box)
+      : surface_(surface), tree_(tree) {
     TopologyScratch scratch;
     triangle_topology(surface.triangles, scratch);
-    rim_edges_ = std::move(scratch.boundary);
+    for (const Edge& e : scratch.boundary)
+      if ((box_sides(surface.points[e.first], box) & box_sides(surface.points[e.second], box)) == 0)
+        rim_edges_.push_back(e);
     rim_vertex_.assign(surface.points.size(), 0);
     for (const Edge& e : rim_edges_) rim_vertex_[e.first] = rim_vertex_[e.second] = 1;
   }
@@ -630,9 +638,15 @@ void split_defects(TetMesh& mesh, const std::vector<TetRegion*>& regions, const 
   for (const Edge& e : splits) splitter.split(e);
 }
 
+// What S is: closed (S_M a sphere), or clipped by the box (its rim, and S_M's, run on the box).
+struct SurfaceKind {
+  bool closed = false;
+  bool rim_on_box = false;
+};
+
 // One healing attempt on one side; returns an empty string on success, else the reason of failure.
 std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier& sides, FaceTag tag, int side,
-                      bool closed, const SurfaceApproximationOptions& options,
+                      SurfaceKind kind, const SurfaceApproximationOptions& options,
                       const std::vector<TetRegion*>& other_regions, HealingStats& stats) {
   clear_tag(mesh, tag);
   std::vector<std::int8_t> node_side;
@@ -671,14 +685,14 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
 
     const std::vector<TetId> doubled = tets_with_two_faces(mesh, s);
     std::vector<Edge> splits = triangles_with_two_rim_edges(mesh, s);
-    const EdgeDefects defects = find_edge_defects(mesh, s, vertex_to_tets(mesh));
+    const EdgeDefects defects = find_edge_defects(mesh, s, vertex_to_tets(mesh), kind.rim_on_box);
     if (defects.unfixable_nodes > 0)
       return std::to_string(defects.unfixable_nodes) +
              " node(s) of S_M lie on the box boundary or on another surface's S_M (the surface is too close "
              "to them for this resolution)";
     if (doubled.empty() && splits.empty() && defects.cross_surface.empty() && defects.dividing.empty() &&
         defects.chords.empty())
-      return accept_disk(mesh, s, closed, reflex_corners.size(), stats);
+      return accept_disk(mesh, s, kind.closed, reflex_corners.size(), stats);
     split_defects(mesh, regions, doubled, std::move(splits), defects, stats);
   }
   return "healing did not converge in " + std::to_string(options.max_healing_passes) + " passes";
@@ -702,8 +716,9 @@ HealingStats approximate_surface(TetMesh& mesh, TetRegion& volumetric, const Tri
                                  const TriangleBVH& tree, int index, const SurfaceApproximationOptions& options,
                                  const std::vector<TetRegion*>& other_regions) {
   const FaceTag tag = interface_tag(index);
-  const SideClassifier sides(surface, tree);
-  const bool closed = is_closed(surface);
+  const SurfaceKind kind{is_closed(surface), reaches_box(surface, mesh.meccano.box)};
+  const SideClassifier sides(surface, tree, mesh.meccano.box);
+  const bool closed = kind.closed;
   std::vector<int> sides_to_try;
   switch (closed ? SideRule::positive_only : options.side_rule) {
     case SideRule::positive_first: sides_to_try = {+1, -1}; break;
@@ -716,7 +731,7 @@ HealingStats approximate_surface(TetMesh& mesh, TetRegion& volumetric, const Tri
     HealingStats stats;
     stats.side = side;
     stats.attempts = side == sides_to_try.front() ? 1 : 2;
-    const std::string failure = heal_side(mesh, volumetric, sides, tag, side, closed, options, other_regions, stats);
+    const std::string failure = heal_side(mesh, volumetric, sides, tag, side, kind, options, other_regions, stats);
     if (failure.empty()) {
       stats.first_side_failure = failures;
       return stats;
@@ -742,8 +757,9 @@ ApproximationFaces approximation_faces(const TetMesh& mesh, const TetRegion& vol
   return result;
 }
 
-SurfaceApproximationCheck check_surface_approximation(const TetMesh& mesh, const TetRegion& volumetric, int index) {
-  return inspect(mesh, read_interface(mesh, volumetric, interface_tag(index)));
+SurfaceApproximationCheck check_surface_approximation(const TetMesh& mesh, const TetRegion& volumetric, int index,
+                                                      bool rim_on_box) {
+  return inspect(mesh, read_interface(mesh, volumetric, interface_tag(index)), rim_on_box);
 }
 
 }  // namespace meccano

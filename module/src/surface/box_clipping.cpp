@@ -113,9 +113,8 @@ std::vector<TriangleSurface> clip_to_box(const TriangleSurface& surface, const B
   for (int axis = 0; axis < 3; ++axis)
     for (bool upper : {false, true}) {
       const double offset = upper ? box.max[axis] : box.min[axis];
-      const bool reaches = std::ranges::any_of(inside.points, [&](const Eigen::Vector3d& p) {
-        return upper ? p[axis] >= offset : p[axis] <= offset;
-      });
+      const bool reaches = std::ranges::any_of(
+          inside.points, [&](const Eigen::Vector3d& p) { return upper ? p[axis] >= offset : p[axis] <= offset; });
       if (reaches && !inside.triangles.empty()) inside = clipped_by_plane(inside, axis, offset, upper);
     }
   if (inside.triangles.empty()) throw InputError(label(surface) + ": no part of the surface lies inside the box");

@@ -4,14 +4,19 @@
 //   self-intersection  triangles_intersect (geometry/geometry.hpp): contact within 1e-12 of the pair's size;
 //                      neighbouring triangles only when they meet away from their shared corners.
 //   inside the box     a vertex closer to a box face than 1e-9 times the box diagonal lies on the
-//                      boundary; farther out than that it is outside.
+//                      boundary; farther out than that it is outside. A rim vertex of an open surface
+//                      may lie exactly on a box plane (a surface clipped by the box).
 //   two surfaces       they touch when closer than 1e-9 times the diagonal of the bounding box of
 //                      both; they intersect when they cross by more than that (penetration depth of a
 //                      pair of triangles, see triangle_separation), so a shallow crossing counts as
 //                      touching.
 #include <meccano/error.hpp>
 #include <meccano/geometry/geometry.hpp>
+#include <meccano/surface/box_clipping.hpp>
+#include <meccano/surface/closed_surface.hpp>
 #include <meccano/surface/validation.hpp>
+
+#include "mesh/topology_helpers.hpp"
 
 #include <algorithm>
 #include <optional>
@@ -123,6 +128,41 @@ void require_strictly_inside_box(const TriangleSurface& surface, const Box& box)
   }
 }
 
+void require_inside_box(const TriangleSurface& surface, const Box& box) {
+  if (is_closed(surface)) {
+    require_strictly_inside_box(surface, box);
+    return;
+  }
+  // Clipped by the box (surface/box_clipping.hpp): rim vertices may lie exactly on its planes.
+  detail::TopologyScratch scratch;
+  detail::triangle_topology(surface.triangles, scratch);
+  // The box planes each vertex's rim edges run on: a rim vertex on a plane must have one of its rim edges
+  // on it, or S would touch the box at a point (where S_M cannot follow it).
+  std::vector<std::uint8_t> rim_planes(surface.points.size(), 0);
+  for (const detail::Edge& e : scratch.boundary) {
+    const auto planes =
+        static_cast<std::uint8_t>(box_sides(surface.points[e.first], box) & box_sides(surface.points[e.second], box));
+    rim_planes[e.first] |= planes;
+    rim_planes[e.second] |= planes;
+  }
+  const double margin = boundary_margin * box.diagonal();
+  for (std::size_t v = 0; v < surface.points.size(); ++v) {
+    const Eigen::Array3d p = surface.points[v].array();
+    const bool outside = !p.allFinite() || (p < box.min.array()).any() || (p > box.max.array()).any();
+    const std::uint8_t planes = box_sides(surface.points[v], box);
+    const bool near_planes = (p <= box.min.array() + margin).any() || (p >= box.max.array() - margin).any();
+    if (!outside && (planes != 0 ? rim_planes[v] == planes : !near_planes)) continue;
+    std::ostringstream out = message_stream();
+    out << label(surface) << ": vertex " << v + 1 << " (" << p[0] << ", " << p[1] << ", " << p[2] << ")";
+    if (outside) out << " is outside the box " << describe(box) << " (clip the surface to the box first)";
+    else if (planes != 0)
+      out << " lies on the box boundary " << describe(box)
+          << ", but the surface's rim does not run along the boundary there (it touches the box at a point)";
+    else out << " lies within " << margin << " of the box boundary " << describe(box) << " without being on it";
+    throw InputError(out.str());
+  }
+}
+
 void require_surfaces_disjoint(const TriangleSurface& a, const TriangleSurface& b) {
   if (a.triangles.empty() || b.triangles.empty()) return;
   const Eigen::AlignedBox3d box_a = bounding_box(a.points);
@@ -160,7 +200,7 @@ void require_surfaces_disjoint(const TriangleSurface& a, const TriangleSurface& 
 void validate_surfaces(std::span<const TriangleSurface> surfaces, const Box& box) {
   for (const TriangleSurface& surface : surfaces) {
     require_surface_topology(surface);
-    require_strictly_inside_box(surface, box);
+    require_inside_box(surface, box);
     require_no_self_intersection(surface);
   }
   for (std::size_t i = 0; i < surfaces.size(); ++i) {

@@ -96,6 +96,7 @@ struct InsertionOptions {
 struct SurfaceInsertion {
   std::string name;
   bool closed = false;      // a closed surface (surface/closed_surface.hpp): V_M is its inside, S_M a sphere
+  bool rim_on_box = false;  // clipped by the box (surface/box_clipping.hpp): its rim and S_M's run on the box
   double resolution = 0.0;  // the l_r it was inserted at: options.resolution, or less after finer retries
   TetRegion volumetric;     // V_M, one flag per tet of the final mesh
   VolumetricStats volumetric_stats;

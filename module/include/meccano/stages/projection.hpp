@@ -15,6 +15,13 @@
 //          3. Each S_M node's parameters u (φ_M^{-1}(x_M), or its place on a crease) are located in S's
 //             parametric triangulation and the node moves to φ(u). Rim nodes land on the rim of S,
 //             corners on its corners, crease nodes on the crease edges of S.
+// Box      where S is clipped by the box (surface/box_clipping.hpp), its rim runs in arcs on the box faces
+//          and inside the box, and so must S_M's (its rim nodes on the box are those of V_M's faces beside the
+//          box). The arcs are matched in order, S_M's transitions (where one arc ends and the next begins)
+//          are pinned on the square's perimeter at the coordinates of S's (RimAnchor), and S's other
+//          corners go to the nodes at the same share of the matched arcs; every rim node then lands on the
+//          arc of S on its own box faces, and keeps its coordinates on them exactly. A rim that runs
+//          entirely on one box face (a cap standing on the box) is matched as an inner rim.
 // Closed   project_closed_onto_surface, for a closed S (surface/closed_surface.hpp) and its closed S_M (a
 //          sphere, built outside S): both are cut along one coordinate plane into two disks, and each half
 //          of S_M is projected onto its half of S as above. The plane passes through S_M's nodes and
@@ -26,8 +33,9 @@
 // Output   the moved mesh (tets may be tangled: step 4 untangles them), the parameterizations, and
 //          statistics: how far nodes moved, how far they are from S afterwards, inverted tets.
 // Errors   UncoveredSurfaceError (a MeshingError) if the rim gap exceeds options.max_rim_gap (the message
-//          names the rim vertex of S farthest from S_M); MeshingError from the parameterization (rim not
-//          one loop, corners impossible, map not one-to-one).
+//          names the rim vertex of S farthest from S_M); MeshingError if S_M's rim runs on the box in other
+//          arcs than S's, or touches it at a node whose rim edges do not run on it; MeshingError from the
+//          parameterization (rim not one loop, corners impossible, map not one-to-one).
 #pragma once
 
 #include <meccano/error.hpp>
@@ -79,13 +87,17 @@ struct RimGap {
 RimGap rim_gap(std::span<const Eigen::Vector3d> surface_points, std::span<const int> surface_rim,
                std::span<const Eigen::Vector3d> approximation_points, std::span<const int> approximation_rim);
 
+// on_rim of a rim node pinned in P (a RimAnchor): where S_M's rim passes from one box face to another or
+// into the box. Like P's corners, it stays where it is.
+inline constexpr std::uint8_t pinned_rim_node = 2;
+
 // What step 4 needs to move S_M nodes within S: φ, and each S_M node's parameters.
 struct SurfaceProjection {
   int surface_index = -1;  // the surface whose S_M this is: its faces are interface_tag(surface_index)
   std::unique_ptr<ParametricSurface> surface;  // φ: P -> S
   std::vector<VertexId> nodes;                 // the S_M nodes
   std::vector<Eigen::Vector2d> uv;             // their parameters (same order)
-  std::vector<std::uint8_t> on_rim;            // same order
+  std::vector<std::uint8_t> on_rim;            // same order: 0 off the rim, 1 on it, pinned_rim_node
   std::vector<std::array<int, 3>> triangles;   // S_M's triangles as indices into `nodes`, oriented like S
   int orientation = 1;                         // the sign of their areas in P (uv), which step 4 keeps
   CreaseNodes creases;                         // which nodes lie on a crease line of S, and where

@@ -40,11 +40,17 @@
 //          inside is a cavity of the tets that meet S, which step 1 fills), every boundary node of V_M on
 //          the positive side, and S_M all of V_M's boundary: a sphere. Only the positive side is tried,
 //          whatever the SideRule; the rules about the rim find nothing; the others apply as they are.
+// Box      where S is clipped by the box (its rim runs on the box faces), V_M reaches the box along that rim,
+//          and so does S_M: the nodes of V_M on the box beside S's rim there take the side of S's normal (S
+//          went on beyond the box), S_M's rim nodes may lie on the box, and edges from S_M to the box are
+//          not refined. An S_M node on the box off S_M's rim is still a defect. Whether S_M's rim runs on
+//          the box faces along the same arcs as S's is checked by the projection (stages/projection.hpp).
 // Output   S_M as the faces tagged interface_tag(k), and the statistics of every rule.
 // Invariants on return (check_surface_approximation): S_M is one connected manifold disk (Euler
 //          characteristic 1, one rim loop, no pinched node), or sphere for a closed S (2, no rim), every rim edge is axis-parallel, no corbel,
 //          tet with two faces in S_M, triangle with two rim edges, cross-surface, dividing or chord edge
-//          remains; no S_M node is on the box boundary or on another S_M. Reflex rim corners that
+//          remains; no S_M node is on another S_M, or on the box boundary unless it is a rim node of a
+//          surface clipped by the box. Reflex rim corners that
 //          could not be filled are counted, not forbidden.
 // Errors   MeshingError naming the rule that did not converge, or the defect that remains, if neither
 //          side heals within the pass limit.
@@ -138,6 +144,8 @@ struct SurfaceApproximationCheck {
   std::string describe() const;
 };
 
-SurfaceApproximationCheck check_surface_approximation(const TetMesh& mesh, const TetRegion& volumetric, int index);
+// `rim_on_box`: S is clipped by the box (surface/box_clipping.hpp), so S_M's rim nodes may lie on the box.
+SurfaceApproximationCheck check_surface_approximation(const TetMesh& mesh, const TetRegion& volumetric, int index,
+                                                      bool rim_on_box = false);
 
 }  // namespace meccano

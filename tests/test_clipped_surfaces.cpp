@@ -4,6 +4,8 @@
 // with the box's nodes still on their planes, and covering S (its area is S's, exactly for a plane).
 
 #include <meccano/geometry/geometry.hpp>
+#include <meccano/inspect/mesh_file_measure.hpp>
+#include <meccano/io/surface_readers.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/mesh/invariants.hpp>
 #include <meccano/mesh/quality.hpp>
@@ -11,15 +13,20 @@
 #include <meccano/surface/box_clipping.hpp>
 #include <meccano/surface/validation.hpp>
 
+#include <run_command.hpp>
 #include <test_surfaces.hpp>
 
 #include <gtest/gtest.h>
+
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -173,6 +180,49 @@ TEST(ClippedSurface, FaultsLeavingThroughOneTwoAndThreeFaces) {
     const TriangleSurface surface = clipped(fault(y_range, z_range), kUnitBox);
     expect_clipped_interface(insert(surface, kUnitBox, 0.07), surface, 0.01);
   }
+}
+
+// Real faults reach the ground: in their box with its top at elevation 0, they are clipped there.
+TEST(ClippedSurface, RealFaultsCutByTheGround) {
+  for (const char* file : {"CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts",
+                           "WTRA-SFFS-ANCP-Malibu_Coast_fault_west_steep_alt2-CFM5_1000m.ts"}) {
+    SCOPED_TRACE(file);
+    const std::optional<TriangleSurface> fault = testing::read_shared_fault(file);
+    if (!fault) GTEST_SKIP() << "the shared faults are not beside the checkout";
+    Box box = testing::box_around(*fault);
+    ASSERT_GT(box.max.z(), 0.0);
+    box.max.z() = 0.0;
+    const TriangleSurface surface = clipped(*fault, box);
+    expect_clipped_interface(insert(surface, box, testing::largest_extent(*fault) / 30), surface, 0.01);
+  }
+}
+
+// Through the tool: the surface file reaches beyond the box, the CLI clips it, and the written mesh
+// passes `check`; `measure` clips the surface to the mesh's box too, so the interface covers all of it.
+TEST(ClippedSurface, TheToolClipsChecksAndMeasures) {
+  const std::filesystem::path work =
+      std::filesystem::temp_directory_path() / ("meccano-clipped-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(work);
+  const std::string surface =
+      testing::write_obj((work / "sheet.obj").string(),
+                         testing::graph_patch([](double x, double y) { return 0.4 + 0.2 * x + 0.05 * std::sin(4 * y); },
+                                              {-0.2, 1.2}, {-0.2, 1.2}, 20));
+  const std::string mesh = (work / "sheet.msh").string();
+  const testing::CommandRun insert =
+      testing::run_command(std::string(MECCANO_CLI) + " --box 0,0,0,1,1,1 --resolution 0.08 --quiet --surface " +
+                           surface + ":sheet --output " + mesh);
+  ASSERT_EQ(insert.status, 0) << insert.output;
+  const testing::CommandRun check = testing::run_command(std::string(MECCANO_CLI) + " check " + mesh);
+  EXPECT_EQ(check.status, 0) << check.output;
+  TriangleSurface whole = read_surface(surface);
+  whole.name = "sheet";
+  const MeshMeasure measure = measure_mesh_file(mesh, {&whole, 1});
+  ASSERT_NE(measure.find("interface_sheet"), nullptr);
+  const SurfaceAccuracy& accuracy = *measure.find("interface_sheet")->accuracy;
+  EXPECT_NEAR(accuracy.area_ratio, 1.0, 1e-3);
+  EXPECT_LT(accuracy.hausdorff, 0.01);
+  EXPECT_LT(accuracy.normal_deviation_max_deg, 5.0);
+  std::filesystem::remove_all(work);
 }
 
 }  // namespace

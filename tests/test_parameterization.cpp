@@ -143,6 +143,35 @@ TEST(Parameterization, RectangularRimsKeepTheirCorners) {
   EXPECT_EQ(found, expected);
 }
 
+// Anchors pin rim vertices at given perimeter coordinates; between pins the rim is spaced by chord length,
+// and without anchors the parameters are those of the corners alone, bit for bit.
+TEST(Parameterization, AnchorsPinRimVerticesOnThePerimeter) {
+  const TriangleSurface sheet = testing::strongly_curved_sheet(6);  // 12 x 6 cells, vertex (i, j) = 13 j + i
+  const std::array<int, 4> corners{0, 12, 90, 78};
+  const SquareParameterization plain = parameterize_to_square(sheet, corners);
+  EXPECT_EQ(parameterize_to_square(sheet, corners, FloaterWeights::mean_value, {}).uv, plain.uv);
+  // Vertex 3 (on side 0) pinned at 0.6, vertex 84 (on side 2, from 90 back to 78) at 2.25.
+  const std::vector<RimAnchor> anchors{{3, 0.6}, {84, 2.25}};
+  const SquareParameterization pinned = parameterize_to_square(sheet, corners, FloaterWeights::mean_value, anchors);
+  EXPECT_EQ(perimeter_coordinate(pinned.uv[3]), 0.6);
+  EXPECT_DOUBLE_EQ(perimeter_coordinate(pinned.uv[84]), 2.25);
+  for (int corner = 0; corner < 4; ++corner) EXPECT_EQ(pinned.uv[corners[corner]], plain.uv[corners[corner]]);
+  // Chord-length spacing between the pins: the rim vertices 1, 2 of the uniform side share 0.6 evenly.
+  EXPECT_NEAR(pinned.uv[1].x(), 0.2, 1e-12);
+  EXPECT_NEAR(pinned.uv[2].x(), 0.4, 1e-12);
+  EXPECT_NEAR(pinned.uv[7].x(), 0.6 + 0.4 * 4.0 / 9.0, 1e-12);
+  // Rim parameters stay on the square's sides.
+  for (int v : pinned.rim) {
+    const Vector2d& uv = pinned.uv[v];
+    EXPECT_TRUE(uv.x() == 0.0 || uv.x() == 1.0 || uv.y() == 0.0 || uv.y() == 1.0) << v;
+  }
+  // Out of order, or off the rim: refused.
+  const std::vector<RimAnchor> crossed{{3, 0.6}, {5, 0.5}};
+  EXPECT_THROW(parameterize_to_square(sheet, corners, FloaterWeights::mean_value, crossed), std::invalid_argument);
+  const std::vector<RimAnchor> inside{{20, 0.5}};
+  EXPECT_THROW(parameterize_to_square(sheet, corners, FloaterWeights::mean_value, inside), std::invalid_argument);
+}
+
 TEST(Parameterization, CircularRimGetsQuarterCorners) {
   const TriangleSurface cap = testing::spherical_cap(12);  // 72 rim vertices, no natural corner
   const std::array<int, 4> corners = corners_by_arc_length(cap);

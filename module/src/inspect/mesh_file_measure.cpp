@@ -3,9 +3,11 @@
 #include <meccano/error.hpp>
 #include <meccano/geometry/geometry.hpp>
 #include <meccano/report/json_writer.hpp>
+#include <meccano/surface/box_clipping.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
@@ -214,7 +216,21 @@ std::string MeshMeasure::json() const {
 }
 
 MeshMeasure measure_msh_mesh(const MshMesh& mesh, std::span<const TriangleSurface> surfaces) {
-  const std::vector<const TriangleSurface*> matched = match_surfaces(mesh, surfaces);
+  // A surface reaching beyond the mesh's box is compared by its part inside, as inserted
+  // (surface/box_clipping.hpp: several parts are NAME_1, NAME_2, ...).
+  Box box{Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()),
+          Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity())};
+  for (const Eigen::Vector3d& p : mesh.points) {
+    box.min = box.min.cwiseMin(p);
+    box.max = box.max.cwiseMax(p);
+  }
+  std::vector<TriangleSurface> inside;
+  for (const TriangleSurface& surface : surfaces) {
+    std::vector<TriangleSurface> parts =
+        mesh.points.empty() ? std::vector<TriangleSurface>{surface} : clip_to_box(surface, box);
+    inside.insert(inside.end(), parts.begin(), parts.end());
+  }
+  const std::vector<const TriangleSurface*> matched = match_surfaces(mesh, inside);
   MeshMeasure measure;
   measure.source = mesh.source;
   measure.nodes = static_cast<std::int64_t>(mesh.points.size());

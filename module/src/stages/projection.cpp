@@ -209,8 +209,7 @@ std::string describe_labels(std::span<const std::uint8_t> labels) {
 // S_M's corners and anchors for an S whose rim runs on the box (at least one transition): S_M's arcs are
 // matched to S's (same labels in the same cyclic order, the rotation whose transitions lie nearest to
 // S's), every transition of S_M is pinned at its partner's perimeter coordinate (a corner where that is
-// one of S's corners), and S's other corners go to the S_M rim node at the same share of the chord length
-// of the matched arc.
+// one of S's corners), and S's other corners go to the S_M rim node of the matched arc nearest to them.
 struct MatchedRim {
   std::array<int, 4> corners{};
   std::vector<RimAnchor> anchors;
@@ -223,7 +222,9 @@ MatchedRim match_box_arcs(const TriangleSurface& surface, std::span<const int> s
   if (static_cast<int>(arcs.start.size()) != m)
     throw MeshingError("the rim of S_M runs on the box in " + std::to_string(arcs.start.size()) +
                        " arcs where S's runs in " + std::to_string(m) + " (box planes of S's arcs: " +
-                       describe_labels(surface_arcs.label) + "; of S_M's: " + describe_labels(arcs.label) + ")");
+                       describe_labels(surface_arcs.label) + "; of S_M's: " + describe_labels(arcs.label) +
+                       "): where S's rim dips into the box and back by less than V_M's tets, S_M runs on along the "
+                       "box");
   int rotation = -1;
   double best = std::numeric_limits<double>::infinity();
   for (int r = 0; r < m; ++r) {
@@ -266,9 +267,10 @@ MatchedRim match_box_arcs(const TriangleSurface& surface, std::span<const int> s
       position[k] = from;
       continue;
     }
-    const double share = forward(at[j], k) / forward(at[j], at[(j + 1) % m]);
-    const double whole = arc_length(from, to);
-    const auto miss = [&](int i) { return std::abs(arc_length(from, i) / whole - share); };
+    // The rim node of the matched arc nearest to S's corner (chord-length shares differ between S's rim
+    // and S_M's staircase by up to kilometres along a fault's deep rim).
+    const Eigen::Vector3d& target = surface.points[surface_parameterization.corners[k]];
+    const auto miss = [&](int i) { return (mesh.points[rim[i]] - target).squaredNorm(); };
     int nearest = -1;
     for (int i = (from + 1) % n; i != to; i = (i + 1) % n)
       if (nearest < 0 || miss(i) < miss(nearest)) nearest = i;

@@ -3,7 +3,9 @@
 // compare. It measures what is in the file; timings are the producers' own.
 //
 // Input   an MshMesh, and surfaces S (TriangleSurface) whose `name` picks the 2D group interface_NAME
-//         each is compared with. A surface need not match every group, nor a group a surface.
+//         each is compared with. A surface need not match every group, nor a group a surface. A surface
+//         that reaches beyond the bounding box of the mesh's nodes is clipped to it first, as the insertion
+//         clips it (surface/box_clipping.hpp; several parts are named NAME_1, NAME_2, ...).
 // Output  a MeshMeasure:
 //   nodes, tets   as in the file;
 //   inverted      tets whose signed volume in the file's vertex order is not positive (or not finite);

@@ -147,7 +147,20 @@ TEST(ClippedSurface, ObliquePlanes) {
       testing::graph_patch([](double x, double y) { return 0.3 + 0.35 * x + 0.1 * y; }, {-0.3, 1.3}, {-0.3, 1.3}, 16),
       kUnitBox);
   EXPECT_NEAR(area(oblique), std::sqrt(1.0 + 0.35 * 0.35 + 0.1 * 0.1), 1e-12);
-  expect_clipped_interface(insert(oblique, kUnitBox, 0.08), oblique);
+  const InsertionResult result = insert(oblique, kUnitBox, 0.08);
+  expect_clipped_interface(result, oblique);
+  // The plane divides the box: below it (its negative side) lies the volume of 0.3 + 0.35 x + 0.1 y.
+  const auto sides = divided_sides(result, 0);
+  ASSERT_TRUE(sides.has_value());
+  std::array<double, 2> volume{};
+  for (TetId t = 0; t < result.mesh.num_tets(); ++t) {
+    const TetPoints p = result.mesh.tet_points(t);
+    const double v = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+    ASSERT_NE((*sides)[0][t], (*sides)[1][t]);
+    volume[(*sides)[1][t]] += std::abs(v);
+  }
+  EXPECT_NEAR(volume[0], 0.3 + 0.35 / 2 + 0.1 / 2, 1e-12);
+  EXPECT_NEAR(volume[1], 1.0 - volume[0], 1e-12);
 
   const TriangleSurface corner = clipped(
       testing::graph_patch([](double x, double y) { return 0.6 - x - y; }, {-0.3, 0.9}, {-0.3, 0.9}, 16), kUnitBox);
@@ -178,7 +191,9 @@ TEST(ClippedSurface, FaultsLeavingThroughOneTwoAndThreeFaces) {
            {{0.2, 0.8}, {0.3, 1.2}}, {{0.3, 1.2}, {0.3, 1.2}}, {{-0.2, 1.2}, {0.3, 1.2}}}) {
     SCOPED_TRACE(y_range[0]);
     const TriangleSurface surface = clipped(fault(y_range, z_range), kUnitBox);
-    expect_clipped_interface(insert(surface, kUnitBox, 0.07), surface, 0.01);
+    const InsertionResult result = insert(surface, kUnitBox, 0.07);
+    expect_clipped_interface(result, surface, 0.01);
+    EXPECT_FALSE(divided_sides(result, 0).has_value()) << "its lower rim runs inside the box";
   }
 }
 
@@ -214,6 +229,8 @@ TEST(ClippedSurface, TheToolClipsChecksAndMeasures) {
   ASSERT_EQ(insert.status, 0) << insert.output;
   const testing::CommandRun check = testing::run_command(std::string(MECCANO_CLI) + " check " + mesh);
   EXPECT_EQ(check.status, 0) << check.output;
+  for (const char* line : {"negative_sheet: ok", "positive_sheet: ok"})
+    EXPECT_NE(check.output.find(line), std::string::npos) << check.output;
   TriangleSurface whole = read_surface(surface);
   whole.name = "sheet";
   const MeshMeasure measure = measure_mesh_file(mesh, {&whole, 1});

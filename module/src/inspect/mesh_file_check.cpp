@@ -43,8 +43,12 @@ class MeshFileChecker {
     report.checks.push_back(box_sides());
     for (const MshGroup& group : mesh_.groups)
       if (group.dimension == 2 && group.name.starts_with("interface_")) report.checks.push_back(interface(group));
-    for (const MshGroup& group : mesh_.groups)
-      if (group.dimension == 3 && group.name.starts_with("inside_")) report.checks.push_back(inside(group));
+    for (const MshGroup& group : mesh_.groups) {
+      if (group.dimension != 3) continue;
+      if (group.name.starts_with("inside_")) report.checks.push_back(bounded_region(group, "inside_", true, false));
+      if (group.name.starts_with("negative_")) report.checks.push_back(bounded_region(group, "negative_", true, true));
+      if (group.name.starts_with("positive_")) report.checks.push_back(bounded_region(group, "positive_", false, true));
+    }
     return report;
   }
 
@@ -246,12 +250,16 @@ class MeshFileChecker {
     return check;
   }
 
-  // inside_NAME: the tets a closed interface_NAME encloses. Across each of its faces the group has one
-  // tet, whose outward normal is the face's (interface faces point out of an inclusion); every other
-  // face between a tet of the group and one outside it is an interface face; no tet of it is on the box.
-  CheckResult inside(const MshGroup& group) const {
+  // A region bounded by interface_NAME: inside_NAME, the tets a closed interface encloses, or
+  // negative_NAME and positive_NAME, the two parts of the box a clipped interface divides it into. Across
+  // each interface face the group has one tet, whose outward normal is the face's (`normals_out`: out of
+  // an inclusion, out of the negative side) or its opposite (into the positive side); every other face
+  // between a tet of the group and one outside it is an interface face; only with `reaches_box` may a
+  // tet of it lie on the box.
+  CheckResult bounded_region(const MshGroup& group, const std::string& prefix, bool normals_out,
+                             bool reaches_box) const {
     CheckResult check = named(group.name);
-    const std::string interface_name = "interface_" + group.name.substr(std::string("inside_").size());
+    const std::string interface_name = "interface_" + group.name.substr(prefix.size());
     const auto interface = std::ranges::find_if(
         mesh_.groups, [&](const MshGroup& g) { return g.dimension == 2 && g.name == interface_name; });
     if (interface == mesh_.groups.end()) {
@@ -279,16 +287,18 @@ class MeshFileChecker {
       const int apex = *std::ranges::find_if(tet, [&](int v) { return std::ranges::find(face, v) == face.end(); });
       const Eigen::Vector3d& a = mesh_.points[face[0]];
       const Eigen::Vector3d normal = (mesh_.points[face[1]] - a).cross(mesh_.points[face[2]] - a);
-      if (!(normal.dot(mesh_.points[apex] - a) < 0.0))
-        problem(check, "triangle ", mesh_.triangle_tags[e], " of ", interface_name, " points into ",
-                tet_name(inner->tet));
+      const double behind = normal.dot(mesh_.points[apex] - a);
+      if (!(normals_out ? behind < 0.0 : behind > 0.0))
+        problem(check, "triangle ", mesh_.triangle_tags[e], " of ", interface_name,
+                normals_out ? " points into " : " points out of ", tet_name(inner->tet));
     }
     std::ranges::sort(bounding);
     CompensatedSum volume;
     for (const int t : group.elements) volume.add(tet_volume(t));
     for_each_face([&](std::span<const FaceRecord> sharing) {
       const auto members = std::ranges::count_if(sharing, [&](const FaceRecord& r) { return member[r.tet]; });
-      if (sharing.size() == 1 && members == 1) problem(check, tet_name(sharing[0].tet), " is on the box boundary");
+      if (sharing.size() == 1 && members == 1 && !reaches_box)
+        problem(check, tet_name(sharing[0].tet), " is on the box boundary");
       else if (sharing.size() == 2 && members == 1 && !std::ranges::binary_search(bounding, sharing[0].key))
         problem(check, face_name(sharing[0].key), " between ", tet_name(sharing[0].tet), " and ",
                 tet_name(sharing[1].tet), " leaves the group without crossing ", interface_name);

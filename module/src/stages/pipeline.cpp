@@ -726,6 +726,16 @@ MeshGroups output_groups(const InsertionResult& result, Stage last_stage) {
         if (inserted.volumetric[t]) volume.tets.push_back(t);
       groups.volumes.push_back(std::move(volume));
     }
+    if (last_stage == Stage::smoothing)
+      if (const auto sides = divided_sides(result, s)) {
+        const int count = static_cast<int>(result.surfaces.size());
+        for (int side = 0; side < 2; ++side) {
+          TetGroup& volume = groups.volumes.emplace_back(TetGroup{
+              (side == 0 ? "negative_" : "positive_") + inserted.name, domain_tag + 1 + count + 2 * s + side, {}});
+          for (TetId t = 0; t < result.mesh.num_tets(); ++t)
+            if ((*sides)[side][t]) volume.tets.push_back(t);
+        }
+      }
     if (inserted.healing_stats.side != 0)
       groups.surfaces.push_back(
           {"interface_" + inserted.name, interface_tag(s),
@@ -755,6 +765,39 @@ std::vector<SurfaceInterface> surface_interfaces(const InsertionResult& result) 
     }
   }
   return interfaces;
+}
+
+std::optional<std::array<TetRegion, 2>> divided_sides(const InsertionResult& result, int s) {
+  const SurfaceInsertion& inserted = result.surfaces[s];
+  if (inserted.closed || !inserted.rim_on_box || inserted.healing_stats.side == 0) return std::nullopt;
+  const TetMesh& mesh = result.mesh;
+  const FaceTag tag = interface_tag(s);
+  // The face-connected parts of the box with S_M's faces as walls.
+  std::vector<int> part(mesh.tets.size(), -1);
+  int parts = 0;
+  std::vector<TetId> stack;
+  for (TetId seed = 0; seed < mesh.num_tets() && parts <= 2; ++seed) {
+    if (part[seed] >= 0) continue;
+    part[seed] = parts;
+    stack.push_back(seed);
+    while (!stack.empty()) {
+      const TetId t = stack.back();
+      stack.pop_back();
+      for (int f = 0; f < 4; ++f) {
+        const TetId across = mesh.neighbours[t][f];
+        if (across == no_tet || mesh.face_tags[t][f] == tag || part[across] >= 0) continue;
+        part[across] = parts;
+        stack.push_back(across);
+      }
+    }
+    ++parts;
+  }
+  if (parts != 2) return std::nullopt;
+  const FaceRef behind = approximation_faces(mesh, inserted.volumetric, s, inserted.healing_stats.side).faces.front();
+  const int negative = part[behind.tet];
+  std::array<TetRegion, 2> sides{TetRegion(mesh.tets.size(), 0), TetRegion(mesh.tets.size(), 0)};
+  for (TetId t = 0; t < mesh.num_tets(); ++t) sides[part[t] == negative ? 0 : 1][t] = 1;
+  return sides;
 }
 
 namespace {

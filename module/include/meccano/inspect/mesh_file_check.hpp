@@ -3,7 +3,7 @@
 // mesh/invariants.hpp checks a TetMesh exactly, on its computational coordinates).
 //
 // Input   an MshMesh: its tets, its 2D groups named xmin ... zmax and interface_*, and its 3D groups
-//         named inside_*, if it has them.
+//         named inside_*, negative_* and positive_*, if it has them.
 // Checks  conformity   every face of a tet is shared by at most two tets; two tets sharing a face lie on
 //                      its two sides; an unshared face lies on the bounding box of the nodes (else a hole);
 //         orientation  every tet has positive volume (the count of negative and flat ones otherwise);
@@ -20,6 +20,9 @@
 //                      of interface_NAME one tet of the group, behind the face's normal (interfaces point
 //                      out of their inclusions); no other face between the group and the rest of the
 //                      mesh; no tet of the group on the box boundary. The summary gives its volume.
+//         negative_NAME, positive_NAME, one per such 3D group (the parts of the box a clipped interface_NAME
+//                      divides it into): as inside_NAME, but the faces of interface_NAME point out of the
+//                      negative part and into the positive one, and both parts reach the box.
 //         Planes and areas are compared to 1e-9 of the box's largest extent (squared for areas).
 // Output  one CheckResult per check, each with its counts and the first problems, naming the file's
 //         element tags; text() for a terminal, json() for a report.
@@ -34,7 +37,8 @@
 namespace meccano {
 
 struct CheckResult {
-  std::string name;  // "conformity", "orientation", "volume", "box sides", "interface_NAME", "inside_NAME"
+  std::string name;  // "conformity", "orientation", "volume", "box sides", "interface_NAME", "inside_NAME",
+                     // "negative_NAME", "positive_NAME"
   bool passed = true;
   std::string summary;                // counts or values, one line
   std::vector<std::string> problems;  // the first max_reported defects found

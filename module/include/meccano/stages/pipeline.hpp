@@ -158,8 +158,10 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
 // `domain`, the box sides, and `interface_NAME` for every surface's S_M (once built), oriented like the
 // surface (out of a closed one); at the inspection stages (last_stage before smoothing) also
 // `volumetric_NAME` for every surface's V_M, and in the final mesh `inside_NAME` for every closed surface:
-// the tets it encloses (its V_M, whose boundary S_M now lies on S). Tags as in io/mesh_writers.hpp: surface
-// k's interface is 7 + k whichever S_M exist, its V_M or inside 2 + k. The final mesh leaves V_M out: formats that write an element once per group (MSH 2.2,
+// the tets it encloses (its V_M, whose boundary S_M now lies on S), and `negative_NAME` and `positive_NAME`
+// for every surface that divides the box (divided_sides). Tags as in io/mesh_writers.hpp: surface k of n's
+// interface is 7 + k whichever S_M exist, its V_M or inside 2 + k, its negative and positive sides
+// 2 + n + 2k and 3 + n + 2k. The final mesh leaves V_M out: formats that write an element once per group (MSH 2.2,
 // VTU) would otherwise hold its tets twice.
 MeshGroups output_groups(const InsertionResult& result, Stage last_stage = Stage::smoothing);
 
@@ -182,5 +184,10 @@ struct SurfaceInterface {
 
 // One entry per surface whose S_M was built (every surface once the approximation stage has run).
 std::vector<SurfaceInterface> surface_interfaces(const InsertionResult& result);
+
+// For a surface clipped by the box whose interface divides the box into two parts: the tets of each, on
+// S's negative side [0] and positive side [1] (the side its normals point to). Empty for a surface that
+// does not divide the box (it reaches the boundary only in part, or is closed: see inside_NAME).
+std::optional<std::array<TetRegion, 2>> divided_sides(const InsertionResult& result, int s);
 
 }  // namespace meccano

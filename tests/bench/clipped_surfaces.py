@@ -105,9 +105,15 @@ def cases(args):
     return found
 
 
+TIMEOUT = 600  # seconds; a run beyond it is reported as such
+
+
 def run(command):
     start = time.time()
-    done = subprocess.run(command, capture_output=True, text=True, timeout=3600)
+    try:
+        done = subprocess.run(command, capture_output=True, text=True, timeout=TIMEOUT)
+    except subprocess.TimeoutExpired:
+        done = subprocess.CompletedProcess(command, -1, "", "stopped after %d s" % TIMEOUT)
     return done, time.time() - start
 
 

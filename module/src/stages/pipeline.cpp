@@ -567,8 +567,10 @@ Clearances clearances(std::span<const TriangleSurface> surfaces, const Box& box)
   Clearances clearance{std::vector<std::vector<double>>(count, std::vector<double>(count, 0.0)),
                        std::vector<double>(count, std::numeric_limits<double>::infinity())};
   for (std::size_t s = 0; s < count; ++s) {
-    for (const Eigen::Vector3d& p : surfaces[s].points)
-      clearance.to_box[s] = std::min({clearance.to_box[s], (p - box.min).minCoeff(), (box.max - p).minCoeff()});
+    // A surface clipped by the box meets it by design: its S_M may reach the box, so it needs no room there.
+    if (!reaches_box(surfaces[s], box))
+      for (const Eigen::Vector3d& p : surfaces[s].points)
+        clearance.to_box[s] = std::min({clearance.to_box[s], (p - box.min).minCoeff(), (box.max - p).minCoeff()});
     const TriangleBVH tree(surfaces[s]);
     for (std::size_t other = 0; other < s; ++other)
       clearance.between[s][other] = clearance.between[other][s] = surface_distance(surfaces[other], tree);

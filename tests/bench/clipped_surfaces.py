@@ -26,6 +26,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 from bench_faults import bounding_box, case_box, read_surface  # noqa: E402
+from closed_surfaces import add_insertion_figures  # noqa: E402
 
 UNIT = [0, 0, 0, 1, 1, 1]
 
@@ -124,15 +125,8 @@ def module_run(args, name, box, path, extent, divisor):
     done, wall = run([tool, "--box", ",".join(repr(c) for c in box), "--surface", path + ":S", "--resolution",
                       repr(resolution), "--output", stem + ".msh", "--report", stem + ".json"])
     row = {"status": done.returncode, "wall": wall, "retries": done.stdout.count("retrying")}
-    if done.returncode != 0:
-        row["error"] = (done.stderr.strip().splitlines() or ["?"])[-1][:300]
+    if not add_insertion_figures(row, done, stem):
         return row
-    report = json.load(open(stem + ".json"))
-    after = report["quality"]["after_smoothing"]
-    row.update(tets=report["tets"], seconds=report["seconds"]["total"], sus=report["seconds"]["smoothing"],
-               eta=(after["meccano"]["min"], after["equilateral"]["min"]),
-               dihedral=(after["min_dihedral_deg"], after["max_dihedral_deg"]),
-               parts=done.stdout.count("clipped by the box"))
     check, _ = run([tool, "check", stem + ".msh", "--quiet"])
     row["check"] = check.returncode == 0
     run([tool, "measure", stem + ".msh", "--surface", path + ":S", "--quiet", "--report", stem + "_measure.json"])
@@ -167,7 +161,7 @@ def main():
                 continue
             print("| %s | E/%d | 0 | %d | %.2f (%.2f) | %d | %s | %.3f / %.3f | %.1f–%.1f° | %.1f / %.2f° | %.1e | %.4f |"
                   % (name, divisor, row["tets"], row["seconds"], row["sus"], row["retries"],
-                     "ok" if row["check"] else "FAILED", row["eta"][0], row["eta"][1], row["dihedral"][0],
+                     "ok" if row["check"] else "FAILED", row["eta_meccano"], row["eta_equilateral"], row["dihedral"][0],
                      row["dihedral"][1], row["normal"][0], row["normal"][1], row["hausdorff"], row["area_ratio"]),
                   flush=True)
 

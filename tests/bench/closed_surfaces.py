@@ -128,6 +128,19 @@ def run(command, timeout=3600):
     return done, time.time() - start
 
 
+def add_insertion_figures(row, done, stem):
+    """The figures of an insertion's report STEM.json in row, or its error if it failed (then False)."""
+    if done.returncode != 0:
+        row["error"] = (done.stderr.strip().splitlines() or ["?"])[-1][:300]
+        return False
+    report = json.load(open(stem + ".json"))
+    after = report["quality"]["after_smoothing"]
+    row.update(tets=report["tets"], seconds=report["seconds"]["total"], sus=report["seconds"]["smoothing"],
+               eta_meccano=after["meccano"]["min"], eta_equilateral=after["equilateral"]["min"],
+               dihedral=(after["min_dihedral_deg"], after["max_dihedral_deg"]))
+    return True
+
+
 def module_run(args, work, case, divisor):
     box, surfaces, radius = CASES[case]
     resolution = radius / divisor
@@ -144,14 +157,8 @@ def module_run(args, work, case, divisor):
     done, seconds = run(command)
     row = {"case": case, "divisor": divisor, "l_r": resolution, "status": done.returncode, "wall": seconds,
            "retries": done.stdout.count("retrying with") + done.stderr.count("retrying with")}
-    if done.returncode != 0:
-        row["error"] = (done.stderr.strip().splitlines() or ["?"])[-1][:300]
+    if not add_insertion_figures(row, done, stem):
         return row
-    report = json.load(open(stem + ".json"))
-    after = report["quality"]["after_smoothing"]
-    row.update(tets=report["tets"], seconds=report["seconds"]["total"], sus=report["seconds"]["smoothing"],
-               eta_meccano=after["meccano"]["min"], eta_equilateral=after["equilateral"]["min"],
-               dihedral=(after["min_dihedral_deg"], after["max_dihedral_deg"]))
     check, _ = run([os.path.join(args.build, "module", "meccano-immerse"), "check", stem + ".msh", "--quiet"])
     row["check"] = check.returncode == 0
     measure = [os.path.join(args.build, "module", "meccano-immerse"), "measure", stem + ".msh", "--quiet",

@@ -118,6 +118,17 @@ void take_parameters(SurfaceProjection& result, std::span<const std::array<int, 
   }
 }
 
+// The box planes a mesh node lies on, bits as box_sides (surface/box_clipping.hpp), from its exact grid point.
+std::uint8_t grid_box_planes(const TetMesh& mesh, VertexId v) {
+  const GridPoint upper = mesh.meccano.upper_corner();
+  std::uint8_t planes = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (mesh.grid[v][axis] == 0) planes |= static_cast<std::uint8_t>(1u << (2 * axis));
+    if (mesh.grid[v][axis] == upper[axis]) planes |= static_cast<std::uint8_t>(1u << (2 * axis + 1));
+  }
+  return planes;
+}
+
 // Every S_M node moves to φ of its parameters.
 void move_nodes_onto_surface(TetMesh& mesh, SurfaceProjection& result, const TriangleBVH& tree) {
   ProjectionStats& stats = result.stats;
@@ -125,12 +136,12 @@ void move_nodes_onto_surface(TetMesh& mesh, SurfaceProjection& result, const Tri
   std::vector<Eigen::Vector3d> moved(result.nodes.size());
 #pragma omp parallel for schedule(dynamic, 256)
   for (std::int64_t i = 0; i < count; ++i) moved[i] = result.surface->evaluate(result.surface->locate(result.uv[i]));
-  const GridPoint upper = mesh.meccano.upper_corner();
   for (std::int64_t i = 0; i < count; ++i) {
     const VertexId v = result.nodes[i];
     // A rim node on the box lands on S's rim on the same box planes: keep its coordinates there exact.
+    const std::uint8_t planes = grid_box_planes(mesh, v);
     for (int axis = 0; axis < 3; ++axis)
-      if (mesh.grid[v][axis] == 0 || mesh.grid[v][axis] == upper[axis]) moved[i][axis] = mesh.points[v][axis];
+      if (planes & (3u << (2 * axis))) moved[i][axis] = mesh.points[v][axis];
     stats.largest_move = std::max(stats.largest_move, (moved[i] - mesh.points[v]).norm());
     mesh.points[v] = moved[i];
     stats.largest_distance_after =
@@ -167,7 +178,6 @@ SurfaceProjection project_disk(TetMesh& mesh, std::span<const std::array<int, 3>
 struct BoxArcs {
   std::vector<int> start;           // loop positions of the transitions, increasing
   std::vector<std::uint8_t> label;  // of the arc that begins there; one label and no start for a uniform rim
-  bool on_box() const { return label.size() > 1 || label.front() != 0; }
 };
 
 // `planes`: the box planes of each rim vertex, in loop order. Throws MeshingError, naming the vertex
@@ -188,16 +198,6 @@ BoxArcs box_arcs(std::span<const std::uint8_t> planes, const std::function<std::
   }
   if (arcs.start.empty()) arcs.label.push_back(label(0));
   return arcs;
-}
-
-std::uint8_t grid_box_planes(const TetMesh& mesh, VertexId v) {
-  const GridPoint upper = mesh.meccano.upper_corner();
-  std::uint8_t planes = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    if (mesh.grid[v][axis] == 0) planes |= static_cast<std::uint8_t>(1u << (2 * axis));
-    if (mesh.grid[v][axis] == upper[axis]) planes |= static_cast<std::uint8_t>(1u << (2 * axis + 1));
-  }
-  return planes;
 }
 
 std::string describe_labels(std::span<const std::uint8_t> labels) {

@@ -1,5 +1,6 @@
-// convergence_study: a manufactured problem (the cube example's flux jump, or the inclusion's coefficient
-// jump) on meshes made by the module, in this process, one per level with h halving, and the errors per
+// convergence_study: a manufactured problem (the cube example's flux jump, the fault example's flux jump
+// with a flux condition where the fault reaches the box top, or the inclusion's coefficient jump) on
+// meshes made by the module, in this process, one per level with h halving, and the errors per
 // level as CSV.
 // Exit status: 0 success, 1 failure (meshing failed, cannot write), 2 usage error.
 
@@ -10,6 +11,7 @@
 #include <meccano/io/atomic_file.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/stages/pipeline.hpp>
+#include <meccano/surface/box_clipping.hpp>
 #include <meccano/surface/validation.hpp>
 
 #include <deal.II/base/mpi.h>
@@ -27,11 +29,13 @@ namespace {
 using namespace solver_demo;
 
 constexpr const char* usage =
-    R"(Usage: convergence_study --levels N --degree 1|2 --csv FILE.csv [--problem cube|inclusion]
+    R"(Usage: convergence_study --levels N --degree 1|2 --csv FILE.csv [--problem cube|fault|inclusion]
                          [--geometry curved|flat]
 
 Solves a manufactured problem of doc/solver.md on N meshes made by the module in this process:
   cube       a flux jump across the cube example's surface S (an open disk),
+  fault      a flux jump across a curved fault S that leaves through the box top, where the flux is
+             given (the ground), u on the other sides; S is clipped by the box,
   inclusion  a coefficient jump (10 inside, 1 outside) across a sphere S of radius 0.3 about the
              box centre, the cells inside it told apart by their material id (inside_sphere);
 and writes one CSV row per level:
@@ -51,13 +55,14 @@ Options:
                   (required)
   --degree 1|2    polynomial degree (required)
   --csv FILE.csv  the table; rewritten after every level (required)
-  --problem NAME  cube (default) or inclusion
+  --problem NAME  cube (default), fault or inclusion
   --geometry G    curved (default): with P2, the cells at S curved onto S; flat: S_h's faces flat
 )";
 
 // A manufactured problem with its surface S, triangulated from its formula with edges of about l_r / 2
-// at most: the n x n grid of the cube example's Q = [0.2, 0.8]² with 0.6 / n <= l_r / 2; the sphere's
-// octahedral triangulation with n cells per octant edge, whose edges are at most about π R / (2n).
+// at most: the n x n grid of the cube example's Q = [0.2, 0.8]² with 0.6 / n <= l_r / 2, the fault's grid
+// with n cells across its width 0.6; the sphere's octahedral triangulation with n cells per octant edge,
+// whose edges are at most about π R / (2n).
 struct Example {
   std::string title;
   InterfaceProblem problem;
@@ -69,12 +74,16 @@ Example example(const std::string& name) {
     return {"the cube example", manufactured_problem(), [](double resolution) {
               return triangulate_cube_example(static_cast<int>(std::ceil(2.0 * 0.6 / resolution)));
             }};
+  if (name == "fault")
+    return {"the fault example", fault_problem(), [](double resolution) {
+              return triangulate_fault_example(static_cast<int>(std::ceil(2.0 * 0.6 / resolution)));
+            }};
   if (name == "inclusion")
     return {"the inclusion", inclusion_problem(),
             [](double resolution) {
       return triangulate_inclusion(static_cast<int>(std::ceil(std::numbers::pi * inclusion.radius / resolution)));
             }};
-  throw UsageError("--problem " + name + ": cube or inclusion");
+  throw UsageError("--problem " + name + ": cube, fault or inclusion");
 }
 
 struct Level {
@@ -90,7 +99,9 @@ Level level_parameters(int level) {
 meccano::DealiiMesh module_mesh(const Level& level, const meccano::TriangleSurface& surface, double& seconds) {
   const auto start = std::chrono::steady_clock::now();
   const meccano::Box box{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}};
-  const std::vector<meccano::TriangleSurface> surfaces{surface};
+  // The part of S inside the box (the fault's triangulation runs above the top), as the CLI inserts it.
+  const std::vector<meccano::TriangleSurface> surfaces =
+      meccano::reaches_box(surface, box) ? meccano::clip_to_box(surface, box) : std::vector{surface};
   meccano::validate_surfaces(surfaces, box);
   meccano::InsertionOptions options;
   options.resolution = level.resolution;

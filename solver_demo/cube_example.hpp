@@ -14,10 +14,11 @@
 // g_S     2 w √(1 + |∇s|²) ≥ 0: S is a source, u has a ridge along it.
 //
 // All functions take physical coordinates and are defined everywhere in R³ (u's kink term vanishes
-// outside the column Q × R).
+// outside the column Q × R). The algebra is kinked_graph.hpp's, which the fault example shares.
 #pragma once
 
 #include "interface_triangles.hpp"
+#include "kinked_graph.hpp"
 
 #include <meccano/surface/triangle_surface.hpp>
 
@@ -25,10 +26,8 @@
 
 namespace solver_demo {
 
-struct ValueAndGradient {
-  double value = 0.0;
-  Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
-};
+// S as a graph over (x, y) with u's kink across it (kinked_graph.hpp).
+extern const KinkedGraph cube_example;
 
 double cube_example_height(double x, double y);                       // s(x, y)
 Eigen::Vector3d cube_example_normal(double x, double y);              // unit, towards +z

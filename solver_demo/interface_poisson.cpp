@@ -6,6 +6,7 @@
 #include "curved_interface.hpp"
 
 #include <meccano/io/atomic_file.hpp>
+#include <meccano/mesh/tet_mesh.hpp>
 
 #include <deal.II/base/function.h>
 #include <deal.II/base/quadrature_lib.h>
@@ -30,43 +31,67 @@
 #include <chrono>
 #include <map>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace solver_demo {
 
 using namespace dealii;
 
-InterfaceProblem manufactured_problem() {
+namespace {
+
+// The flux jump of kinked_graph.hpp across the graph's S, with β = 1 and u given on the box sides.
+InterfaceProblem flux_jump_problem(const KinkedGraph& graph, std::string description) {
   using material_id = InterfaceProblem::material_id;
-  return {"manufactured solution of the cube example (doc/solver.md)",
-          [](material_id) { return 1.0; },
-          [](const Eigen::Vector3d& p, material_id) { return manufactured_right_hand_side(p); },
-          [](const Eigen::Vector3d& p) { return manufactured_solution(p).value; },
-          manufactured_interface_source,
-          [](const Eigen::Vector3d& p, material_id) { return manufactured_solution(p); },
-          ExactSurface{project_onto_cube_example,
-                       [](const Eigen::Vector3d& p) { return cube_example_normal(p.x(), p.y()); }}};
+  const KinkedGraph* g = &graph;
+  return {.description = std::move(description),
+          .coefficient = [](material_id) { return 1.0; },
+          .right_hand_side = [g](const Eigen::Vector3d& p, material_id) { return kinked_right_hand_side(*g, p); },
+          .boundary_values = [g](const Eigen::Vector3d& p) { return kinked_solution(*g, p).value; },
+          .interface_source = [g](const Eigen::Vector3d& p) { return kinked_interface_source(*g, p); },
+          .exact_solution = [g](const Eigen::Vector3d& p, material_id) { return kinked_solution(*g, p); },
+          .exact_surface = ExactSurface{[g](const Eigen::Vector3d& p) { return graph_point(*g, p); },
+                                        [g](const Eigen::Vector3d& p) { return graph_normal(*g, p); }}};
+}
+
+}  // namespace
+
+InterfaceProblem manufactured_problem() {
+  return flux_jump_problem(cube_example, "manufactured solution of the cube example (doc/solver.md)");
+}
+
+InterfaceProblem fault_problem() {
+  InterfaceProblem problem = flux_jump_problem(
+      fault_example, "flux jump across the fault example's fault, flux given on the top (doc/solver.md)");
+  problem.flux_sides = {meccano::box_side_tag(meccano::BoxSide::zmax)};
+  problem.boundary_flux = [](const Eigen::Vector3d& p, const Eigen::Vector3d& outward_normal) {
+    return kinked_solution(fault_example, p).gradient.dot(outward_normal);
+  };
+  return problem;
 }
 
 InterfaceProblem inclusion_problem(dealii::types::material_id inside) {
   using material_id = InterfaceProblem::material_id;
-  return {"coefficient jump across the inclusion example's sphere (doc/solver.md)",
-          [inside](material_id m) { return m == inside ? inclusion.beta_inside : inclusion.beta_outside; },
-          [inside](const Eigen::Vector3d& p, material_id m) { return inclusion_right_hand_side(p, m == inside); },
-          [](const Eigen::Vector3d& p) { return inclusion_solution(p, false).value; },
-          [](const Eigen::Vector3d&) { return 0.0; },
-          [inside](const Eigen::Vector3d& p, material_id m) { return inclusion_solution(p, m == inside); },
-          ExactSurface{project_onto_inclusion, inclusion_normal}};
+  return {
+      .description = "coefficient jump across the inclusion example's sphere (doc/solver.md)",
+      .coefficient = [inside](material_id m) { return m == inside ? inclusion.beta_inside : inclusion.beta_outside; },
+      .right_hand_side = [inside](const Eigen::Vector3d& p,
+                                  material_id m) { return inclusion_right_hand_side(p, m == inside); },
+      .boundary_values = [](const Eigen::Vector3d& p) { return inclusion_solution(p, false).value; },
+      .interface_source = [](const Eigen::Vector3d&) { return 0.0; },
+      .exact_solution = [inside](const Eigen::Vector3d& p,
+                                 material_id m) { return inclusion_solution(p, m == inside); },
+      .exact_surface = ExactSurface{project_onto_inclusion, inclusion_normal}};
 }
 
 InterfaceProblem unit_source_problem() {
-  return {"-Δu = 0, u = 0 on the box sides, unit flux jump on S",
-          [](InterfaceProblem::material_id) { return 1.0; },
-          [](const Eigen::Vector3d&, InterfaceProblem::material_id) { return 0.0; },
-          [](const Eigen::Vector3d&) { return 0.0; },
-          [](const Eigen::Vector3d&) { return 1.0; },
-          {},
-          {}};
+  return {.description = "-Δu = 0, u = 0 on the box sides, unit flux jump on S",
+          .coefficient = [](InterfaceProblem::material_id) { return 1.0; },
+          .right_hand_side = [](const Eigen::Vector3d&, InterfaceProblem::material_id) { return 0.0; },
+          .boundary_values = [](const Eigen::Vector3d&) { return 0.0; },
+          .interface_source = [](const Eigen::Vector3d&) { return 1.0; },
+          .exact_solution = {},
+          .exact_surface = {}};
 }
 
 namespace {
@@ -89,6 +114,7 @@ class InterfacePoisson {
   void solve();
   void evaluate();
   void output_results(const std::string& prefix) const;
+  bool is_flux_side(types::boundary_id id) const;
 
   MPI_Comm communicator;
   const InterfaceProblem& problem;
@@ -155,8 +181,8 @@ void InterfacePoisson::make_grid(const meccano::DealiiMesh& input, const std::st
 }
 
 // Degrees of freedom, the Dirichlet constraints u = g_D on every boundary face (S's faces are interior)
-// whatever its boundary id: 1-6 on the box sides, 0 on the faces a foreign mesh puts in no side group;
-// and the sparsity of the distributed matrix.
+// outside Γ_N, whatever its boundary id: 1-6 on the box sides, 0 on the faces a foreign mesh puts in no
+// side group; and the sparsity of the distributed matrix.
 void InterfacePoisson::setup_system() {
   dof_handler.distribute_dofs(fe);
   report.dofs = dof_handler.n_dofs();
@@ -170,7 +196,8 @@ void InterfacePoisson::setup_system() {
   const ScalarFunctionFromFunctionObject<3> boundary_values(
       [this](const Point<3>& p) { return problem.boundary_values(to_eigen(p)); });
   std::map<types::boundary_id, const Function<3>*> dirichlet;
-  for (const types::boundary_id id : triangulation.get_boundary_ids()) dirichlet.emplace(id, &boundary_values);
+  for (const types::boundary_id id : triangulation.get_boundary_ids())
+    if (!is_flux_side(id)) dirichlet.emplace(id, &boundary_values);
   VectorTools::interpolate_boundary_values(mapping, dof_handler, dirichlet, constraints);
   constraints.close();
 
@@ -180,13 +207,20 @@ void InterfacePoisson::setup_system() {
   system_matrix.reinit(locally_owned_dofs, locally_owned_dofs, dsp, communicator);
 }
 
-// A_ij = ∫_Ω β ∇φ_i·∇φ_j and F_i = ∫_Ω f φ_i cell by cell, then F_i += ∫_S g_S φ_i face by face. The
-// surface term is what makes the gradient of u_h jump across S; it has no matrix part, so the
-// constraints only drop its constrained rows.
+bool InterfacePoisson::is_flux_side(types::boundary_id id) const {
+  return std::find(problem.flux_sides.begin(), problem.flux_sides.end(), id) != problem.flux_sides.end();
+}
+
+// A_ij = ∫_Ω β ∇φ_i·∇φ_j and F_i = ∫_Ω f φ_i + ∫_Γ_N g_N φ_i cell by cell, then F_i += ∫_S g_S φ_i face by
+// face. The surface terms have no matrix part, so the constraints only drop their constrained rows; the
+// one on S is what makes the gradient of u_h jump across S.
 void InterfacePoisson::assemble_system() {
   const QGaussSimplex<3> quadrature(fe.degree + 1);
   FEValues<3> fe_values(mapping, fe, quadrature,
                         update_values | update_gradients | update_quadrature_points | update_JxW_values);
+  const QGaussSimplex<2> face_quadrature(fe.degree + 2);
+  FEFaceValues<3> fe_face_values(mapping, fe, face_quadrature,
+                                 update_values | update_normal_vectors | update_quadrature_points | update_JxW_values);
   const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
   FullMatrix<double> cell_matrix(dofs_per_cell, dofs_per_cell);
   Vector<double> cell_rhs(dofs_per_cell);
@@ -207,13 +241,21 @@ void InterfacePoisson::assemble_system() {
         cell_rhs(i) += f * fe_values.shape_value(i, q) * fe_values.JxW(q);
       }
     }
+    for (const unsigned int f : cell->face_indices()) {
+      if (!cell->at_boundary(f) || !is_flux_side(cell->face(f)->boundary_id())) continue;
+      ++report.flux_faces;
+      fe_face_values.reinit(cell, f);
+      for (const unsigned int q : fe_face_values.quadrature_point_indices()) {
+        const double g = problem.boundary_flux(to_eigen(fe_face_values.quadrature_point(q)),
+                                               to_eigen(Point<3>(fe_face_values.normal_vector(q))));
+        for (const unsigned int i : fe_face_values.dof_indices())
+          cell_rhs(i) += g * fe_face_values.shape_value(i, q) * fe_face_values.JxW(q);
+      }
+    }
     cell->get_dof_indices(dof_indices);
     constraints.distribute_local_to_global(cell_matrix, cell_rhs, dof_indices, system_matrix, system_rhs);
   }
 
-  const QGaussSimplex<2> face_quadrature(fe.degree + 2);
-  FEFaceValues<3> fe_face_values(mapping, fe, face_quadrature,
-                                 update_values | update_quadrature_points | update_JxW_values);
   for (const meccano::InterfaceCellFace& face : interface_faces) {
     const DoFHandler<3>::active_cell_iterator cell(&triangulation, face.negative->level(), face.negative->index(),
                                                    &dof_handler);
@@ -229,6 +271,7 @@ void InterfacePoisson::assemble_system() {
   }
   system_matrix.compress(VectorOperation::add);
   system_rhs.compress(VectorOperation::add);
+  report.flux_faces = Utilities::MPI::sum(report.flux_faces, communicator);
 }
 
 // The matrix is symmetric positive definite: CG, preconditioned by one V-cycle of ML's smoothed

@@ -1,12 +1,13 @@
 // The demo solver: an elliptic problem with a surface S immersed in a tet mesh, across which the solution's
 // gradient jumps, by a flux source on S or by a jump of the coefficient:
 //
-//   −∇·(β∇u) = f in Ω,   u = g_D on ∂Ω,   β∂u/∂n|⁻ − β∂u/∂n|⁺ = g_S on S,
+//   −∇·(β∇u) = f in Ω,   u = g_D on Γ_D,   β∂u/∂n = g_N on Γ_N,   β∂u/∂n|⁻ − β∂u/∂n|⁺ = g_S on S,
 //
-// whose weak form is: find u ∈ H¹(Ω), u = g_D on ∂Ω, with ∫_Ω β ∇u·∇v = ∫_Ω f v + ∫_S g_S v for all
-// v ∈ H¹₀(Ω). S enters through that surface integral and through β, constant on each cell and set by
-// its material id (the cells a closed S encloses have their own), so the mesh must have S as a set of
-// faces (the module's output); u is continuous across S and its gradient jumps there.
+// Γ_N the box sides the problem names (none, or the top of the fault example), Γ_D the rest of ∂Ω; whose
+// weak form is: find u ∈ H¹(Ω), u = g_D on Γ_D, with ∫_Ω β ∇u·∇v = ∫_Ω f v + ∫_Γ_N g_N v + ∫_S g_S v for
+// all v ∈ H¹(Ω) vanishing on Γ_D. S enters through that surface integral and through β, constant on
+// each cell and set by its material id (the cells a closed S encloses have their own), so the mesh must
+// have S as a set of faces (the module's output); u is continuous across S and its gradient jumps there.
 //
 // Input    the mesh as the deal.II adapter gives it (meccano::DealiiMesh, from an insertion or an MSH
 //          file; only MPI rank 0's copy is read), the name of its interface S (DealiiMesh::interface:
@@ -16,8 +17,8 @@
 //          included), built from meccano::fullydistributed_description: rank 0 builds the coarse mesh
 //          with S's faces marked by their manifold id, METIS partitions it; each rank takes the S faces
 //          of the cells it owns on S's negative side (meccano::interface_cell_faces). u = g_D on every
-//          boundary face, whatever its boundary id (box sides 1-6, other faces 0). CG with Trilinos ML
-//          AMG, relative residual 1e-12.
+//          boundary face whose boundary id (box sides 1-6, other faces 0) is not one of the problem's
+//          flux sides. CG with Trilinos ML AMG, relative residual 1e-12.
 //          Geometry: affine tets, S_h's faces flat; for P2 when the problem knows S exactly
 //          (InterfaceProblem::exact_surface), the cells are curved onto S instead: S_h's vertices are
 //          moved onto S and a degree-2 MappingFE puts the midpoints of S_h's edges on S
@@ -27,6 +28,7 @@
 #pragma once
 
 #include "cube_example.hpp"
+#include "fault_example.hpp"
 #include "inclusion_example.hpp"
 #include "interface_triangles.hpp"
 
@@ -36,6 +38,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace solver_demo {
 
@@ -57,6 +60,10 @@ struct InterfaceProblem {
   std::function<double(const Eigen::Vector3d&)> interface_source;                       // g_S
   std::function<ValueAndGradient(const Eigen::Vector3d&, material_id)> exact_solution;  // empty when unknown
   std::optional<ExactSurface> exact_surface;                                            // empty when unknown
+  // Γ_N: the boundary ids (box sides, meccano::box_side_tag) where β∂u/∂n = g_N is given instead of u;
+  // g_N at a point with the outward unit normal there. Empty: u = g_D on all of ∂Ω.
+  std::vector<dealii::types::boundary_id> flux_sides = {};
+  std::function<double(const Eigen::Vector3d& point, const Eigen::Vector3d& outward_normal)> boundary_flux = {};
 };
 
 // The cube example's manufactured solution (cube_example.hpp); S must be the cube example's surface.
@@ -64,6 +71,8 @@ InterfaceProblem manufactured_problem();
 // The inclusion example's coefficient jump (inclusion_example.hpp); S must be its sphere, and the cells
 // inside it must carry `inside` as material id (2 for the mesh's first surface).
 InterfaceProblem inclusion_problem(dealii::types::material_id inside = 2);
+// The fault example's flux jump with a flux condition on the box top (fault_example.hpp); S must be its fault.
+InterfaceProblem fault_problem();
 // Any surface: β = 1, f = 0, g_D = 0, g_S = 1. u is the potential of a uniform source on S.
 InterfaceProblem unit_source_problem();
 
@@ -71,11 +80,13 @@ struct SolveReport {
   unsigned long long cells = 0;
   unsigned long long dofs = 0;
   unsigned long long interface_faces = 0;
-  double h = 0.0;       // longest edge
-  bool curved = false;  // cells curved onto S (InterfaceProblem::exact_surface, P2)
+  unsigned long long flux_faces = 0;  // boundary faces on Γ_N (InterfaceProblem::flux_sides)
+  double h = 0.0;                     // longest edge
+  bool curved = false;                // cells curved onto S (InterfaceProblem::exact_surface, P2)
   unsigned int cg_iterations = 0;
   // Flux balance: what the sources put in, ∫_Ω f + ∫_S g_S, against what leaves through the box sides
-  // by the discrete gradient, −∫_∂Ω ∇u_h·n. Equal for the exact solution; they agree as h → 0.
+  // by the discrete gradient, −∫_∂Ω β∇u_h·n (Γ_N included). Equal for the exact solution; they agree
+  // as h → 0.
   double source = 0.0;
   double outflow = 0.0;
   double l2_norm = 0.0;            // ‖u_h‖_L2

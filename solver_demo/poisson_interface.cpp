@@ -7,6 +7,7 @@
 
 #include <meccano/error.hpp>
 #include <meccano/io/atomic_file.hpp>
+#include <meccano/mesh/tet_mesh.hpp>
 #include <meccano/report/json_writer.hpp>
 
 #include <deal.II/base/mpi.h>
@@ -33,6 +34,8 @@ If S is a surface of doc/solver.md's manufactured problems (every interface node
 5 % of the mean interface edge), that problem is solved, and the errors in L2 and in the H1 seminorm
 and the angles between the faces' normals and S's are printed:
   the cube example's surface (meshes/cube_example.obj): the flux jump above;
+  the fault example's fault through the box top (x = s(y, z), solver_demo/fault_example.hpp): the
+  flux jump above with du/dn = g_N on the top (boundary id 6, zmax) instead of u = g_D;
   the inclusion's sphere (radius 0.3 about (0.5, 0.5, 0.5), with its cells in inside_NAME: the
   mesh's only volume group, every cell of it inside the sphere): -div(beta grad u) = f with
   beta = 10 inside, 1 outside, no flux jump.
@@ -50,7 +53,8 @@ Options:
   --vtu PREFIX        write PREFIX.vtu (u_h, and u_h - I_h u where u is known; PREFIX.pvtu and
                       PREFIX.RANK.vtu under MPI) and PREFIX_interface.vtu (S's triangles)
   --report FILE.json  the run as JSON (rank 0 writes it): mesh, interface, degree, cells, dofs, h,
-                      cg_iterations, problem (cube, inclusion or unit_source), manufactured
+                      cg_iterations, problem (cube, fault, inclusion or unit_source), flux_faces (on the
+                      sides where the problem gives the flux), manufactured
                       (true or false), curved (true or false), errors {l2, h1} and
                       normal_angle_deg {max, mean} for a manufactured problem, norms {l2,
                       h1_seminorm}, flux {source, outflow, relative_difference}, seconds {read, setup,
@@ -73,7 +77,7 @@ void write_report(const std::string& path, const Options& options, const meccano
   json.key("interface").value("interface_" + interface.name);
   json.key("degree").value(degree).key("cells").value(report.cells).key("dofs").value(report.dofs);
   json.key("h").value(report.h).key("cg_iterations").value(report.cg_iterations);
-  json.key("problem").value(problem);
+  json.key("problem").value(problem).key("flux_faces").value(report.flux_faces);
   json.key("manufactured").value(normals.has_value());  // the normals are measured against the known S
   json.key("curved").value(report.curved);
   if (normals) {
@@ -106,8 +110,8 @@ const meccano::DealiiInterface& file_interface(const meccano::DealiiMesh& mesh, 
 // Which manufactured problem the file's S belongs to, decided on rank 0 by S's nodes and, for the
 // inclusion, by the cells it encloses.
 struct Recognised {
-  std::string problem = "unit_source";  // or "cube", "inclusion"
-  SurfaceMatch cube, inclusion;
+  std::string problem = "unit_source";  // or "cube", "fault", "inclusion"
+  SurfaceMatch cube, fault, inclusion;
   dealii::types::material_id inside = 0;  // the inclusion's cells
 };
 
@@ -129,9 +133,12 @@ std::optional<dealii::types::material_id> inclusion_material(const meccano::Deal
 Recognised recognise(const meccano::DealiiMesh& mesh, const meccano::DealiiInterface& interface) {
   Recognised recognised;
   recognised.cube = match_cube_example_surface(interface);
+  recognised.fault = match_fault_example_surface(interface);
   recognised.inclusion = match_surface(interface, project_onto_inclusion);
   if (recognised.cube.matches()) {
     recognised.problem = "cube";
+  } else if (recognised.fault.matches()) {
+    recognised.problem = "fault";
   } else if (const auto inside = inclusion_material(mesh); recognised.inclusion.matches() && inside) {
     recognised.problem = "inclusion";
     recognised.inside = *inside;
@@ -141,8 +148,20 @@ Recognised recognise(const meccano::DealiiMesh& mesh, const meccano::DealiiInter
 
 InterfaceProblem problem_named(const std::string& name, dealii::types::material_id inside) {
   if (name == "cube") return manufactured_problem();
+  if (name == "fault") return fault_problem();
   if (name == "inclusion") return inclusion_problem(inside);
   return unit_source_problem();
+}
+
+// Where the flux is given and where the values, as the solver found the box sides in the mesh.
+std::string boundary_conditions(const InterfaceProblem& problem, const SolveReport& report) {
+  std::string sides;
+  for (const dealii::types::boundary_id id : problem.flux_sides)
+    sides += (sides.empty() ? "" : ", ") + std::string(meccano::box_side_name(static_cast<meccano::BoxSide>(id - 1)));
+  if (sides.empty()) return "u = g_D on every boundary face";
+  if (report.flux_faces == 0) return "u = g_D on every boundary face (the mesh has no faces in " + sides + ")";
+  return "flux given on " + sides + " (" + std::to_string(report.flux_faces) +
+         " faces), u = g_D on the other boundary faces";
 }
 
 void solve(MPI_Comm communicator, const Options& options) {
@@ -179,14 +198,18 @@ void solve(MPI_Comm communicator, const Options& options) {
   if (problem_name == "cube")
     std::cout << "surface     the cube example's (nodes within " << recognised.cube.max_deviation
               << " of its formula, tolerance " << recognised.cube.tolerance << "): the manufactured flux jump\n";
+  else if (problem_name == "fault")
+    std::cout << "surface     the fault example's (nodes within " << recognised.fault.max_deviation
+              << " of its formula, tolerance " << recognised.fault.tolerance
+              << "): the manufactured flux jump across a fault through the top\n";
   else if (problem_name == "inclusion")
     std::cout << "surface     the inclusion's sphere (nodes within " << recognised.inclusion.max_deviation
               << " of it, tolerance " << recognised.inclusion.tolerance << "; the cells of material " << inside
               << " inside it): the manufactured coefficient jump\n";
   else
     std::cout << "surface     not the cube example's (nodes up to " << recognised.cube.max_deviation
-              << " off its formula, tolerance " << recognised.cube.tolerance
-              << ") nor the inclusion's with its cells: f = 0, g_D = 0, g_S = 1\n";
+              << " off its formula, tolerance " << recognised.cube.tolerance << "), the fault example's (up to "
+              << recognised.fault.max_deviation << ") nor the inclusion's with its cells: f = 0, g_D = 0, g_S = 1\n";
   if (problem.exact_surface) {
     normals = normal_error(surface, problem.exact_surface->normal);
     fields.emplace_back("normal_angle_deg", normals->per_triangle_deg);
@@ -194,6 +217,7 @@ void solve(MPI_Comm communicator, const Options& options) {
               << " deg (area-weighted)\n";
   }
   if (report.curved) std::cout << "geometry    the cells at S curved onto S (degree-2 mapping)\n";
+  std::cout << "boundary    " << boundary_conditions(problem, report) << '\n';
   std::cout << "system      P" << degree << ", " << report.dofs << " dofs, " << report.interface_faces
             << " faces on S, CG + AMG: " << report.cg_iterations << " iterations\n"
             << std::setprecision(12) << std::scientific;

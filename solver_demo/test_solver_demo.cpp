@@ -5,6 +5,7 @@
 
 #include "cube_example.hpp"
 #include "curved_interface.hpp"
+#include "fault_example.hpp"
 #include "inclusion_example.hpp"
 #include "interface_poisson.hpp"
 #include "interface_triangles.hpp"
@@ -14,6 +15,7 @@
 #include <meccano/io/surface_readers.hpp>
 #include <meccano/mesh/cube_meccano.hpp>
 #include <meccano/stages/pipeline.hpp>
+#include <meccano/surface/box_clipping.hpp>
 #include <meccano/surface/closed_surface.hpp>
 
 #include <run_command.hpp>
@@ -54,96 +56,172 @@ namespace fs = std::filesystem;
 using Eigen::Vector3d;
 
 // ---------------------------------------------------------------------------------------------------
-// The manufactured solution
+// The flux-jump examples' manufactured solutions (kinked_graph.hpp): the cube example's S, a graph over
+// (x, y) whose kink fades out on all four sides of its rectangle, and the fault example's, a graph over
+// (y, z) whose kink fades out on three sides and runs into the box top on the fourth.
 
-// Random points of the box, away from S by more than `gap` in z.
-std::vector<Vector3d> points_off_surface(int count, double gap) {
-  std::mt19937 random(5);
-  std::uniform_real_distribution<double> coordinate(0.05, 0.95);
-  std::vector<Vector3d> points;
-  while (static_cast<int>(points.size()) < count) {
-    const Vector3d p(coordinate(random), coordinate(random), coordinate(random));
-    if (std::abs(p.z() - cube_example_height(p.x(), p.y())) > gap) points.push_back(p);
+struct KinkedExample {
+  const char* name;
+  const KinkedGraph* graph;
+  Eigen::Vector2d origin, extent;                 // S's rectangle in the box, in (x_a, x_b)
+  std::vector<std::pair<int, double>> rim_walls;  // (0 for x_a, 1 for x_b; its value) where w fades out
+};
+
+void PrintTo(const KinkedExample& example, std::ostream* out) { *out << example.name; }
+
+const KinkedExample kinked_examples[] = {
+    {"cube", &cube_example, {0.2, 0.2}, {0.6, 0.6}, {{0, 0.2}, {0, 0.8}, {1, 0.2}, {1, 0.8}}},
+    {"fault", &fault_example, {0.2, 0.35}, {0.6, 0.65}, {{0, 0.2}, {0, 0.8}, {1, 0.35}}},
+};
+
+class ManufacturedSolution : public ::testing::TestWithParam<KinkedExample> {
+ protected:
+  const KinkedGraph& graph() const { return *GetParam().graph; }
+  ValueAndGradient u(const Vector3d& p) const { return kinked_solution(graph(), p); }
+  double f(const Vector3d& p) const { return kinked_right_hand_side(graph(), p); }
+
+  // The point with planar coordinates `ab` and height coordinate t.
+  Vector3d point(const Eigen::Vector2d& ab, double t) const {
+    Vector3d p;
+    p[(graph().height_axis + 1) % 3] = ab.x();
+    p[(graph().height_axis + 2) % 3] = ab.y();
+    p[graph().height_axis] = t;
+    return p;
   }
-  return points;
-}
+  // Random points of the box, away from S by more than `gap` along the height axis.
+  std::vector<Vector3d> points_off_surface(int count, double gap) const {
+    std::mt19937 random(5);
+    std::uniform_real_distribution<double> coordinate(0.05, 0.95);
+    std::vector<Vector3d> points;
+    while (static_cast<int>(points.size()) < count) {
+      const Vector3d p(coordinate(random), coordinate(random), coordinate(random));
+      if ((p - graph_point(graph(), p)).norm() > gap) points.push_back(p);
+    }
+    return points;
+  }
+  // Random points of S over its rectangle, 0.01 in from its sides.
+  std::vector<Vector3d> points_on_surface(int count) const {
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> unit(0.01, 0.99);
+    std::vector<Vector3d> points;
+    for (int i = 0; i < count; ++i) {
+      const Eigen::Vector2d ab =
+          GetParam().origin + GetParam().extent.cwiseProduct(Eigen::Vector2d(unit(random), unit(random)));
+      points.push_back(graph_point(graph(), point(ab, 0.0)));
+    }
+    return points;
+  }
+};
 
-TEST(ManufacturedSolution, GradientIsTheDerivativeOfTheValue) {
+TEST_P(ManufacturedSolution, GradientIsTheDerivativeOfTheValue) {
   const double step = 1e-6;
   for (const Vector3d& p : points_off_surface(200, 1e-3)) {
-    const Vector3d gradient = manufactured_solution(p).gradient;
+    const Vector3d gradient = u(p).gradient;
     for (int k = 0; k < 3; ++k) {
       const Vector3d e = step * Vector3d::Unit(k);
-      const double difference =
-          (manufactured_solution(p + e).value - manufactured_solution(p - e).value) / (2.0 * step);
+      const double difference = (u(p + e).value - u(p - e).value) / (2.0 * step);
       EXPECT_NEAR(gradient[k], difference, 1e-6 * (1.0 + std::abs(difference))) << "at " << p.transpose();
     }
   }
 }
 
-TEST(ManufacturedSolution, RightHandSideIsMinusTheLaplacian) {
+TEST_P(ManufacturedSolution, RightHandSideIsMinusTheLaplacian) {
   const double step = 1e-4;
   for (const Vector3d& p : points_off_surface(200, 1e-2)) {
     double laplacian = 0.0;
     for (int k = 0; k < 3; ++k) {
       const Vector3d e = step * Vector3d::Unit(k);
-      laplacian += (manufactured_solution(p + e).value - 2.0 * manufactured_solution(p).value +
-                    manufactured_solution(p - e).value) /
-                   (step * step);
+      laplacian += (u(p + e).value - 2.0 * u(p).value + u(p - e).value) / (step * step);
     }
-    EXPECT_NEAR(manufactured_right_hand_side(p), -laplacian, 1e-4 * (1.0 + std::abs(laplacian)))
-        << "at " << p.transpose();
+    EXPECT_NEAR(f(p), -laplacian, 1e-4 * (1.0 + std::abs(laplacian))) << "at " << p.transpose();
   }
 }
 
-// g_S = ∂u/∂n from below − ∂u/∂n from above, by one-sided differences of u along S's normal; u itself
-// is continuous across S.
-TEST(ManufacturedSolution, InterfaceSourceIsTheJumpOfTheNormalDerivative) {
-  std::mt19937 random(7);
-  std::uniform_real_distribution<double> coordinate(0.21, 0.79);
+// g_S = ∂u/∂n from the back − ∂u/∂n from the front, by one-sided differences of u along S's normal; u
+// itself is continuous across S.
+TEST_P(ManufacturedSolution, InterfaceSourceIsTheJumpOfTheNormalDerivative) {
   const double step = 1e-6;
   double largest = 0.0;
-  for (int i = 0; i < 200; ++i) {
-    const double x = coordinate(random), y = coordinate(random);
-    const Vector3d p(x, y, cube_example_height(x, y)), n = cube_example_normal(x, y);
-    const double u = manufactured_solution(p).value;
-    const double below = (u - manufactured_solution(p - step * n).value) / step;
-    const double above = (manufactured_solution(p + step * n).value - u) / step;
-    EXPECT_NEAR(manufactured_interface_source(p), below - above, 1e-4) << "at " << p.transpose();
-    EXPECT_NEAR(manufactured_solution(p - 1e-9 * n).value, manufactured_solution(p + 1e-9 * n).value, 1e-8);
-    largest = std::max(largest, below - above);
+  for (const Vector3d& p : points_on_surface(200)) {
+    const Vector3d n = graph_normal(graph(), p);
+    const double back = (u(p).value - u(p - step * n).value) / step;
+    const double front = (u(p + step * n).value - u(p).value) / step;
+    EXPECT_NEAR(kinked_interface_source(graph(), p), back - front, 1e-4) << "at " << p.transpose();
+    EXPECT_NEAR(u(p - 1e-9 * n).value, u(p + 1e-9 * n).value, 1e-8);
+    largest = std::max(largest, back - front);
   }
   EXPECT_GT(largest, 1.0);  // the kink is there to be resolved
 }
 
-// Across the side walls of the column over S's rim the kink term vanishes with three derivatives, so u,
-// ∇u, f and f's derivative across the wall are continuous there (the walls are no mesh faces: a kink of f
+// Across the walls over S's rim inside the box the kink term vanishes with three derivatives, so u, ∇u,
+// f and f's derivative across the wall are continuous there (the walls are no mesh faces: a kink of f
 // there would cost P2 its L2 order), and there is no flux jump beyond the rim.
-TEST(ManufacturedSolution, KinkFadesOutAtTheRim) {
+TEST_P(ManufacturedSolution, KinkFadesOutAtTheRim) {
   const double step = 1e-9;
-  for (const double t : {0.25, 0.5, 0.75})
-    for (const double z : {0.1, 0.47, 0.9}) {
-      const double y = 0.2 + 0.6 * t;
-      for (const double wall : {0.2, 0.8}) {
-        const Vector3d inside(wall + (wall < 0.5 ? step : -step), y, z),
-            outside(wall + (wall < 0.5 ? -step : step), y, z);
-        EXPECT_NEAR(manufactured_solution(inside).value, manufactured_solution(outside).value, 1e-8);
-        EXPECT_LT((manufactured_solution(inside).gradient - manufactured_solution(outside).gradient).norm(), 1e-7);
-        EXPECT_NEAR(manufactured_right_hand_side(inside), manufactured_right_hand_side(outside), 1e-6);
+  const KinkedExample& example = GetParam();
+  for (const auto& [across, wall] : example.rim_walls) {
+    const int along = 1 - across;
+    const double inward = wall < example.origin[across] + 0.5 * example.extent[across] ? 1.0 : -1.0;
+    for (const double fraction : {0.25, 0.5, 0.75})
+      for (const double t : {0.1, 0.47, 0.9}) {
+        Eigen::Vector2d ab;
+        ab[along] = example.origin[along] + fraction * example.extent[along];
+        ab[across] = wall;
+        const Vector3d unit = point(ab + inward * Eigen::Vector2d::Unit(across), t) - point(ab, t);
+        const Vector3d inside = point(ab, t) + step * unit, outside = point(ab, t) - step * unit;
+        EXPECT_NEAR(u(inside).value, u(outside).value, 1e-8);
+        EXPECT_LT((u(inside).gradient - u(outside).gradient).norm(), 1e-7);
+        EXPECT_NEAR(f(inside), f(outside), 1e-6);
         // f's derivative across the wall from either side, by second-order one-sided differences (with
-        // the cutoff B³ they differ by about 10² here).
-        const Vector3d across = 1e-5 * (inside - outside).normalized();
-        const auto one_sided = [](const Vector3d& at, const Vector3d& h) {
-          return (4.0 * manufactured_right_hand_side(at + h) - manufactured_right_hand_side(at + 2.0 * h) -
-                  3.0 * manufactured_right_hand_side(at)) /
-                 (2.0 * h.norm());
+        // the cutoff B³ they differ by about 10² on the cube example's).
+        const Vector3d h = 1e-5 * unit;
+        const auto one_sided = [this](const Vector3d& at, const Vector3d& d) {
+          return (4.0 * f(at + d) - f(at + 2.0 * d) - 3.0 * f(at)) / (2.0 * d.norm());
         };
-        const double f_inside = one_sided(inside, across), f_outside = -one_sided(outside, -across);
-        EXPECT_NEAR(f_inside, f_outside, 1e-2) << "wall x = " << wall << ", y = " << y << ", z = " << z;
+        EXPECT_NEAR(one_sided(inside, h), -one_sided(outside, -h), 1e-2)
+            << "wall " << wall << " at " << inside.transpose();
+        EXPECT_EQ(kinked_interface_source(graph(), graph_point(graph(), point(ab, t) - 1e-3 * unit)), 0.0);
       }
-    }
-  EXPECT_EQ(manufactured_interface_source({0.2, 0.5, cube_example_height(0.2, 0.5)}), 0.0);
-  EXPECT_EQ(manufactured_interface_source({0.1, 0.5, 0.5}), 0.0);
+  }
+  EXPECT_EQ(kinked_interface_source(graph(), point(example.origin - Eigen::Vector2d::Constant(0.1), 0.5)), 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Graphs, ManufacturedSolution, ::testing::ValuesIn(kinked_examples),
+                         [](const auto& example) { return std::string(example.param.name); });
+
+// The fault's kink does not fade out where S leaves the box: at the top its source is that of the
+// rectangle's middle, and the top's flux ∂u/∂z = g_N jumps across S's trace there.
+TEST(FaultExample, KinkRunsIntoTheBoxTop) {
+  const Vector3d trace = project_onto_fault({0.0, 0.5, 1.0});
+  EXPECT_EQ(trace.z(), 1.0);
+  EXPECT_GT(kinked_interface_source(fault_example, trace), 1.5);  // 2 w |∇d| with w = 1 there
+  const Vector3d n = fault_normal(trace);
+  const InterfaceProblem problem = fault_problem();
+  ASSERT_EQ(problem.flux_sides, std::vector<dealii::types::boundary_id>{6});  // zmax
+  const Vector3d up = Vector3d::UnitZ();
+  const double back = problem.boundary_flux(trace - 1e-9 * n, up), front = problem.boundary_flux(trace + 1e-9 * n, up);
+  EXPECT_GT(std::abs(back - front), 0.1);
+  EXPECT_NEAR(problem.boundary_flux(trace + 1e-3 * n, up),
+              kinked_solution(fault_example, trace + 1e-3 * n).gradient.z(), 1e-15);
+}
+
+// The fault's triangulation leaves the box through its top, with normals towards +x, and clipping it
+// leaves one disk with its rim on the top along S's trace.
+TEST(FaultExample, TriangulationLeavesThroughTheTop) {
+  const meccano::TriangleSurface fault = triangulate_fault_example(12);
+  const meccano::Box box{{0, 0, 0}, {1, 1, 1}};
+  ASSERT_TRUE(meccano::reaches_box(fault, box));
+  for (const auto& t : fault.triangles)
+    EXPECT_GT((fault.points[t[1]] - fault.points[t[0]]).cross(fault.points[t[2]] - fault.points[t[0]]).x(), 0.0);
+  const std::vector<meccano::TriangleSurface> inside = meccano::clip_to_box(fault, box);
+  ASSERT_EQ(inside.size(), 1u);
+  int on_top = 0;
+  for (const Vector3d& p : inside[0].points) {
+    EXPECT_LE(p.z(), 1.0);
+    EXPECT_LT((p - project_onto_fault(p)).norm(), 1e-3);  // on the chords of S
+    on_top += p.z() == 1.0;
+  }
+  EXPECT_GE(on_top, 13);  // a crossing on every column of the grid
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -732,21 +810,55 @@ TEST_F(Programs, StudyErrorsShrinkWithH) {
   EXPECT_LT(fine[5], coarse[5]);
 }
 
-// The inclusion's coefficient jump on two small levels: errors shrinking by about the optimal factors
-// as h halves, for P1 (L2 by 4, H1 by 2) and for P2 on cells curved onto S (L2 by 8, H1 by 4).
-TEST_F(Programs, InclusionStudyConverges) {
-  for (const auto& [degree, l2_ratio, h1_ratio] : {std::tuple{"1", 3.4, 1.8}, std::tuple{"2", 6.0, 3.3}}) {
-    const Execution study = run_command(std::string(SOLVER_DEMO_STUDY) + " --levels 2 --problem inclusion --degree " +
-                                        degree + " --csv " + path("inclusion.csv"));
+// Two small levels of the study: errors shrinking by about the optimal factors as h halves, for P1 (L2 by
+// 4, H1 by 2) and for P2 on cells curved onto S (L2 by 8, H1 by 4): the inclusion's coefficient jump, and
+// the fault's flux jump with the flux given on the top, where S's trace must be mesh edges.
+TEST_F(Programs, InclusionAndFaultStudiesConverge) {
+  // measured: inclusion P1 4.09 and 2.11, P2 7.17 and 3.77; fault P1 3.50 and 1.79, P2 8.13 and 3.89
+  for (const auto& [problem, degree, l2_ratio, h1_ratio] :
+       {std::tuple{"inclusion", "1", 3.4, 1.8}, std::tuple{"inclusion", "2", 6.0, 3.3},
+        std::tuple{"fault", "1", 3.0, 1.6}, std::tuple{"fault", "2", 6.5, 3.3}}) {
+    const Execution study = run_command(std::string(SOLVER_DEMO_STUDY) + " --levels 2 --problem " + problem +
+                                        " --degree " + degree + " --csv " + path("study.csv"));
     ASSERT_EQ(study.status, 0) << study.output;
     std::string header;
-    const auto rows = read_csv(path("inclusion.csv"), header);
+    const auto rows = read_csv(path("study.csv"), header);
     ASSERT_EQ(rows.size(), 2u);
-    // measured: P1 4.09 and 2.11, P2 7.17 and 3.77
-    EXPECT_GT(rows[0][3] / rows[1][3], l2_ratio) << "P" << degree;
-    EXPECT_GT(rows[0][4] / rows[1][4], h1_ratio) << "P" << degree;
+    EXPECT_GT(rows[0][3] / rows[1][3], l2_ratio) << problem << " P" << degree;
+    EXPECT_GT(rows[0][4] / rows[1][4], h1_ratio) << problem << " P" << degree;
     EXPECT_LT(rows[1][5], rows[0][5]);  // the normals' error shrinks
   }
+}
+
+// poisson_interface on the fault example's mesh (S clipped by the box top): it recognises the fault and
+// takes the flux on the top (zmax) from g_N; the same mesh without the zmax group, whose top faces then
+// have boundary id 0 and take u = g_D, gives another solution with the same exact u.
+TEST_F(Programs, FaultFileHasAFluxConditionOnTheTop) {
+  const std::vector<meccano::TriangleSurface> fault =
+      meccano::clip_to_box(triangulate_fault_example(23), {{0, 0, 0}, {1, 1, 1}});
+  ASSERT_EQ(fault.size(), 1u);
+  const meccano::InsertionResult result = insert(fault[0], 9, 0.0541);
+  meccano::write_msh41(result.mesh, meccano::output_groups(result), path("fault.msh"));
+  const std::string without_top = changed_file(result, "no_top.msh", [](meccano::MeshGroups& groups) {
+    std::erase_if(groups.surfaces, [](const auto& g) { return g.name == "zmax"; });
+  });
+  const Execution flux = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + path("fault.msh") + " --report " +
+                                     path("fault.json"));
+  const Execution values = run_command(std::string(SOLVER_DEMO_POISSON) + " --mesh " + without_top);
+  ASSERT_EQ(flux.status, 0) << flux.output;
+  ASSERT_EQ(values.status, 0) << values.output;
+  for (const Execution* run : {&flux, &values})
+    EXPECT_NE(run->output.find("the fault example's"), std::string::npos) << run->output;
+  EXPECT_NE(flux.output.find("flux given on zmax"), std::string::npos) << flux.output;
+  EXPECT_EQ(values.output.find("flux given on"), std::string::npos) << values.output;
+  std::ifstream file(path("fault.json"));
+  const std::string report((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(report.find("\"problem\": \"fault\""), std::string::npos) << report;
+  const double with_flux = value_after(flux.output, "L2 error"), with_values = value_after(values.output, "L2 error");
+  EXPECT_LT(with_flux, 0.02);    // measured 1.12e-2 (the study's first level)
+  EXPECT_LT(with_values, 0.02);  // measured 9.2e-3
+  EXPECT_GT(std::abs(with_flux - with_values), 0.01 * with_values);
+  EXPECT_LT(value_after(flux.output, "balance     relative difference"), 0.1);  // measured 5.9e-2
 }
 
 // poisson_interface recognises the inclusion by its sphere and the cells inside it: with them it

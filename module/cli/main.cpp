@@ -55,9 +55,12 @@ Options:
                            1.26·h·2^(-K/3) on average (the longest √3·h/2^k at K = 3k), h the cell edge
                            (by default about the box's shortest extent). A solver's accuracy away from
                            the surfaces depends on K: the default leaves 6 tets per cell there
-  --surface FILE[:NAME]    a triangulated surface strictly inside the box, open (a disk) or closed (a
-                           sphere: its inside becomes the 3D group inside_NAME) (.obj, .stl, .off,
+  --surface FILE[:NAME]    a triangulated surface, open (a disk) or closed (a sphere strictly inside
+                           the box: its inside becomes the 3D group inside_NAME) (.obj, .stl, .off,
                            .msh, .ts GOCAD TSurf); NAME defaults to its 1-based position (may repeat).
+                           An open surface that reaches the box is clipped to it: each part inside
+                           must be a disk (NAME_1, NAME_2, ... by area when there are several), and
+                           one that divides the box adds the 3D groups negative_NAME, positive_NAME.
                            Coordinates are taken as in the file: a TSurf's z is its own (a ZPOSITIVE
                            Depth file keeps its positive depths), so give the box in the same terms
   --weld-tolerance D       weld the vertices of each surface file closer than D (absolute, in the

@@ -17,9 +17,14 @@ const char* box_side_name(BoxSide side) {
 
 Eigen::Vector3d MeccanoGrid::to_physical(const GridPoint& g) const {
   const double scale = 1.0 / static_cast<double>(grid_cell);
-  return box.min + Eigen::Vector3d(cell_size.x() * static_cast<double>(g[0]) * scale,
-                                   cell_size.y() * static_cast<double>(g[1]) * scale,
-                                   cell_size.z() * static_cast<double>(g[2]) * scale);
+  Eigen::Vector3d p = box.min + Eigen::Vector3d(cell_size.x() * static_cast<double>(g[0]) * scale,
+                                                cell_size.y() * static_cast<double>(g[1]) * scale,
+                                                cell_size.z() * static_cast<double>(g[2]) * scale);
+  // min + cells · (extent / cells) may round away from max: the upper box planes are exactly the box's,
+  // as the surfaces clipped to them are.
+  for (int k = 0; k < 3; ++k)
+    if (g[k] == cells[k] * grid_cell) p[k] = box.max[k];
+  return p;
 }
 
 GridPoint MeccanoGrid::upper_corner() const {

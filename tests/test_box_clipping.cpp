@@ -13,6 +13,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <map>
@@ -161,6 +162,77 @@ TEST(BoxClipping, ARimTouchingTheBoxAtAPointIsRefusedByValidation) {
   } catch (const InputError& error) {
     EXPECT_THAT(error.what(), HasSubstr("touches the box at a point"));
   }
+}
+
+// The vertices of a surface's grid row at y (within 1e-9), by increasing x.
+std::vector<int> row_at(const TriangleSurface& s, double y) {
+  std::vector<int> row;
+  for (int v = 0; v < static_cast<int>(s.points.size()); ++v)
+    if (std::abs(s.points[v].y() - y) < 1e-9) row.push_back(v);
+  std::ranges::sort(row, {}, [&](int v) { return s.points[v].x(); });
+  return row;
+}
+
+// A sheet whose edge at y = 0.95 zigzags across the box side y = 1: out of the box at every other vertex,
+// 0.015 inside at the others but one, 0.04 inside there. Snapping within 0.02 sets the shallow ones onto
+// the plane (each on rim edges whose other end lies beyond it) and leaves the deep one; a vertex of the
+// opposite edge 0.01 from y = 0, whose rim neighbours are far from it, stays too: alone on the plane it
+// would touch the box at a point.
+TEST(BoxClipping, SnappingSetsShallowRimEdgesOntoTheBox) {
+  TriangleSurface sheet =
+      testing::graph_patch([](double x, double) { return 0.5 + 0.1 * x; }, {0.2, 0.8}, {0.2, 0.95}, 12, "sheet");
+  const std::vector<int> edge = row_at(sheet, 0.95), opposite = row_at(sheet, 0.2);
+  ASSERT_EQ(edge.size(), 13u);
+  for (std::size_t i = 0; i < edge.size(); ++i) sheet.points[edge[i]].y() = i % 2 == 0 ? 1.03 : 0.985;
+  sheet.points[edge[5]].y() = 0.96;
+  sheet.points[opposite[3]].y() = 0.01;
+  const TriangleSurface before = sheet;
+
+  const RimSnap snap = snap_rim_to_box(sheet, kUnitBox, 0.02);
+  EXPECT_EQ(snap.vertices, 5);  // edge[1], [3], [7], [9], [11]
+  EXPECT_NEAR(snap.largest_move, 0.015, 1e-12);
+  for (std::size_t v = 0; v < sheet.points.size(); ++v) {
+    const auto i = std::ranges::find(edge, static_cast<int>(v)) - edge.begin();
+    const bool snapped = i < 13 && i % 2 == 1 && i != 5;
+    if (snapped) {
+      EXPECT_EQ(sheet.points[v].y(), 1.0) << "edge vertex " << i;
+      EXPECT_EQ(sheet.points[v].x(), before.points[v].x());
+    } else {
+      EXPECT_EQ(sheet.points[v], before.points[v]) << "vertex " << v;
+    }
+  }
+  // Clipped, its rim runs along the box side wherever the edge came within 0.02 of it.
+  const TriangleSurface part = clip_to_box(sheet, kUnitBox).front();
+  expect_rim_on_box_planes(part, kUnitBox);
+  int dipping = 0;  // vertices near the side but not on it: only edge[5]'s dip
+  for (const Eigen::Vector3d& p : part.points) dipping += p.y() > 0.9 && p.y() < 1.0;
+  EXPECT_EQ(dipping, 1);
+}
+
+// A rim that folds back under its neighbours (a hook at the edge): setting it onto the box would turn
+// triangles over. Refused, naming a triangle and the move, and the surface is left as it was.
+TEST(BoxClipping, SnappingThatTurnsATriangleOverIsRefused) {
+  TriangleSurface sheet =
+      testing::graph_patch([](double x, double) { return 0.5 + 0.1 * x; }, {0.2, 0.8}, {0.2, 0.8}, 6, "hook");
+  const std::vector<int> edge = row_at(sheet, 0.8);
+  for (const int v : edge) {
+    sheet.points[v].y() = 0.65;  // below the row at 0.7: the last strip folds back
+    sheet.points[v].z() += 0.1;
+  }
+  const TriangleSurface before = sheet;
+  const Box box{{-1.0, -1.0, -1.0}, {2.0, 1.0, 2.0}};  // the hook's edge alone within 0.4 of a side
+  try {
+    snap_rim_to_box(sheet, box, 0.4);
+    FAIL() << "accepted";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("hook: setting its rim onto the box within 0.4"));
+    EXPECT_THAT(error.what(), HasSubstr("turns triangle"));
+    EXPECT_THAT(error.what(), HasSubstr(" moves by 0."));
+  }
+  EXPECT_EQ(sheet.points, before.points);
+  // Within 0.1 nothing is near the box, and nothing moves.
+  EXPECT_EQ(snap_rim_to_box(sheet, box, 0.1).vertices, 0);
+  EXPECT_EQ(sheet.points, before.points);
 }
 
 }  // namespace

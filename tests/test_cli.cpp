@@ -156,7 +156,11 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
        "--weld-tolerance must not be negative"},
       {"--box 0,0,0,1,1,1 --surface s.ts --resolution 0.1 --weld-tolerance x --output " + path("a.msh"),
        "--weld-tolerance: 'x' is not a finite number"},
-      {"--box 0,0,0,1,1,1 --split-parts --output " + path("a.msh"), "--split-parts need at least one --surface"},
+      {"--box 0,0,0,1,1,1 --split-parts --output " + path("a.msh"),
+       "--split-parts and --snap-to-box need at least one --surface"},
+      {"--box 0,0,0,1,1,1 --snap-to-box 10 --output " + path("a.msh"), "--snap-to-box need at least one --surface"},
+      {"--box 0,0,0,1,1,1 --snap-to-box -1 --surface s.obj --resolution 0.1 --output " + path("a.msh"),
+       "--snap-to-box must not be negative"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --stage projection --histograms h.csv --output " +
            path("a.msh"),
        "needs --stage smoothing"},

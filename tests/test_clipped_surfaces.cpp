@@ -3,6 +3,7 @@
 // whose interface is a disk on S with its rim on S's rim: on the box faces exactly where S meets them,
 // with the box's nodes still on their planes, and covering S (its area is S's, exactly for a plane).
 
+#include <meccano/error.hpp>
 #include <meccano/geometry/geometry.hpp>
 #include <meccano/inspect/mesh_file_measure.hpp>
 #include <meccano/io/surface_readers.hpp>
@@ -27,6 +28,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -210,6 +212,52 @@ TEST(ClippedSurface, RealFaultsCutByTheGround) {
     const TriangleSurface surface = clipped(*fault, box);
     expect_clipped_interface(insert(surface, box, testing::largest_extent(*fault) / 30), surface, 0.01);
   }
+}
+
+// The mean elevation of the rim vertices in the top tenth of the surface's height (tests/bench/
+// clipped_surfaces.py's "mean top").
+double mean_top(const TriangleSurface& surface) {
+  std::map<std::pair<int, int>, int> uses;
+  for (const auto& t : surface.triangles)
+    for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
+  double low = surface.points[0].z(), high = low;
+  for (const Eigen::Vector3d& p : surface.points) {
+    low = std::min(low, p.z());
+    high = std::max(high, p.z());
+  }
+  std::set<int> top;
+  for (const auto& [edge, n] : uses)
+    for (const int v : {edge.first, edge.second})
+      if (n == 1 && surface.points[v].z() >= high - 0.1 * (high - low)) top.insert(v);
+  double sum = 0.0;
+  for (const int v : top) sum += surface.points[v].z();
+  return sum / static_cast<double>(top.size());
+}
+
+// East Huasna with the box top at its mean top: its top edge leaves the box and dips back into it five
+// times by up to 220 m, less than V_M's 2 km tets, so S_M runs on along the box top and the insertion
+// fails (stages/projection.hpp). With the rim set onto the box within E/200 (293 m) it is valid.
+TEST(ClippedSurface, ARealFaultWhoseTopDipsBelowTheBoxTopIsSnappedOntoIt) {
+  const std::optional<TriangleSurface> fault =
+      testing::read_shared_fault("CRFA-REHZ-EHSN-East_Huasna_fault-CFM4_1000m.ts");
+  if (!fault) GTEST_SKIP() << "the shared faults are not beside the checkout";
+  Box box = testing::box_around(*fault);
+  box.max.z() = mean_top(*fault);
+  const double extent = testing::largest_extent(*fault);
+
+  const TriangleSurface dipping = clipped(*fault, box);
+  validate_surfaces({&dipping, 1}, box);
+  InsertionOptions options;
+  options.resolution = extent / 30;
+  options.finer_retries = 0;
+  EXPECT_THROW(insert_surfaces(make_cube_meccano(box, 0), {&dipping, 1}, options), MeshingError);
+
+  TriangleSurface snapped = *fault;
+  const RimSnap snap = snap_rim_to_box(snapped, box, extent / 200);
+  EXPECT_GT(snap.vertices, 5);
+  EXPECT_LE(snap.largest_move, extent / 200);
+  const TriangleSurface surface = clipped(snapped, box);
+  expect_clipped_interface(insert(surface, box, extent / 30), surface, 0.01);
 }
 
 // Through the tool: the surface file reaches beyond the box, the CLI clips it, and the written mesh

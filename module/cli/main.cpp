@@ -69,6 +69,11 @@ Options:
                            AXIS_UNIT, or 1e-6 of its bounding-box diagonal when the unit is missing or
                            unknown; 1e-10 of the diagonal for the other formats, which then drop
                            nothing)
+  --snap-to-box D          set the rim of each surface onto the box where it runs within D of a box
+                           plane without reaching it (absolute, in the file's units; default 0, off):
+                           for a fault whose top edge follows the ground only roughly, with the box
+                           top at the ground. Only whole rim edges move, each vertex along the
+                           plane's normal; the surface's progress line counts them and the largest move
   --split-parts            insert each part of a surface file (its triangles joined through shared
                            edges) as its own surface NAME_1, NAME_2, ... in file order; without it a
                            .ts file of several parts is an error that names them
@@ -211,6 +216,7 @@ struct Options {
   std::vector<std::pair<std::string, std::string>> surfaces;  // file, name
   meccano::SurfaceReadOptions reading;
   bool split_parts = false;
+  double snap_to_box = 0.0;
   std::optional<double> resolution;
   std::optional<meccano::Stage> stage;
   meccano::SideRule side_rule = meccano::SideRule::positive_first;
@@ -259,6 +265,9 @@ void declare_mesh_options(ArgumentParser& parser, Options& options) {
   });
   parser.value({"--weld-tolerance"}, [&](const std::string& text) {
     options.reading.weld_tolerance = meccano::tools::parse_non_negative("--weld-tolerance", text);
+  });
+  parser.value({"--snap-to-box"}, [&](const std::string& text) {
+    options.snap_to_box = meccano::tools::parse_non_negative("--snap-to-box", text);
   });
   parser.value({"--resolution"}, [&](const std::string& text) {
     const double l = meccano::tools::parse_numbers("--resolution", text, 1)[0];
@@ -365,8 +374,8 @@ void check_option_combinations(const Options& options) {
     throw UsageError("--resolution, --stage and --histograms need at least one --surface");
   if (options.histograms && options.stage && *options.stage != meccano::Stage::smoothing)
     throw UsageError("--histograms compares the mesh before and after smoothing: it needs --stage smoothing");
-  if (options.surfaces.empty() && (options.reading.weld_tolerance || options.split_parts))
-    throw UsageError("--weld-tolerance and --split-parts need at least one --surface");
+  if (options.surfaces.empty() && (options.reading.weld_tolerance || options.split_parts || options.snap_to_box > 0))
+    throw UsageError("--weld-tolerance, --split-parts and --snap-to-box need at least one --surface");
   // Distinct names stay distinct with --split-parts, which splits every surface: in a part's NAME_K,
   // K is what follows the last '_'.
   meccano::tools::check_distinct_names(options.surfaces);
@@ -428,11 +437,21 @@ std::vector<meccano::TriangleSurface> read_surfaces(const std::vector<std::pair<
   return surfaces;
 }
 
-// Surfaces that reach the box boundary clipped to the box: the part inside, each of its disks a surface.
+// Surfaces that reach the box boundary clipped to the box: the part inside, each of its disks a surface;
+// first, with --snap-to-box, their rims set onto the box where they run near it.
 std::vector<meccano::TriangleSurface> clipped_to_box(std::vector<meccano::TriangleSurface> surfaces,
-                                                     const meccano::Box& box, const Progress& progress) {
+                                                     const Options& options, const Progress& progress) {
+  const meccano::Box& box = options.box;
   std::vector<meccano::TriangleSurface> inside;
   for (meccano::TriangleSurface& surface : surfaces) {
+    if (options.snap_to_box > 0) {
+      const meccano::RimSnap snap = meccano::snap_rim_to_box(surface, box, options.snap_to_box);
+      if (snap.vertices > 0)
+        progress.say("surface ", surface.name, ": ", snap.vertices,
+                     " rim vertices set onto the box (--snap-to-box), "
+                     "moved by up to ",
+                     snap.largest_move);
+    }
     if (!meccano::reaches_box(surface, box)) {
       inside.push_back(std::move(surface));
       continue;
@@ -482,7 +501,7 @@ int run(const Options& options) {
   const auto cells = meccano_cells(options, progress);
   // Read and validate every surface before any meshing: bad input must not cost a meshing run.
   std::vector<meccano::TriangleSurface> surfaces =
-      clipped_to_box(read_surfaces(options.surfaces, options, progress), options.box, progress);
+      clipped_to_box(read_surfaces(options.surfaces, options, progress), options, progress);
   meccano::validate_surfaces(surfaces, options.box);
   if (!surfaces.empty()) progress.say("surfaces valid: disks and spheres, inside the box, disjoint");
 
@@ -627,7 +646,7 @@ int run_sequence(const std::vector<std::string>& args) {
   for (int k = 0; k < steps; ++k) {
     try {
       surfaces.push_back(
-          clipped_to_box(read_surfaces(parsed.steps[k], options, Progress(true)), options.box, Progress(true)));
+          clipped_to_box(read_surfaces(parsed.steps[k], options, Progress(true)), options, Progress(true)));
       meccano::validate_surfaces(surfaces.back(), options.box);
     } catch (const meccano::InputError& error) {
       throw meccano::InputError("step " + std::to_string(k) + ": " + error.what());

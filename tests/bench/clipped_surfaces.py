@@ -3,6 +3,7 @@
 that reach the box").
 
 usage: clipped_surfaces.py [--build DIR] [--work DIR] [--divisors 30,50] [--cases NAME,...] [--faults DIR]
+                           [--snap FRACTION]
 
 Synthetic cases, in the unit box unless said: planes across the box along z and x, an oblique plane
 through four faces, a plane cutting off a box corner (three faces, three box edges), a wavy sheet across a
@@ -10,7 +11,9 @@ through four faces, a plane cutting off a box corner (three faces, three box edg
 edge), and three faces. Real cases: every fault of ../shared/data/faults/ in its box of bench_faults.py
 (its bounding box grown by E/10), with the box top lowered to elevation 0 (the ground, where the faults
 reach up to +1.6 km) and to the faults' mean top (the mean elevation of the rim vertices in the top tenth
-of the fault's height). E is the case's largest extent (the box's for synthetic cases, the fault's for real
+of the fault's height), each also with `--snap-to-box E * FRACTION` (cases `_z0_snap`, `_mean_top_snap`;
+default FRACTION 1/200, about 300 m: the rim set onto the box where it runs that close to it). E is the case's
+largest extent (the box's for synthetic cases, the fault's for real
 ones); l_r = E / divisor. Each result is checked with `meccano-immerse check` and measured against the
 surface with `meccano-immerse measure` (which clips it to the mesh's box as the insertion does).
 Timings are single runs: compare rows, not runs.
@@ -87,12 +90,12 @@ def mean_top(points, triangles):
 
 
 def cases(args):
-    """name -> (box, surface file, E)."""
+    """name -> (box, surface file, E, --snap-to-box distance or 0)."""
     found = {}
     for name, (box, (points, triangles)) in SYNTHETIC.items():
         path = os.path.join(args.work, name + ".obj")
         write_obj(path, points, triangles)
-        found[name] = (box, path, max(box[3] - box[0], box[4] - box[1], box[5] - box[2]))
+        found[name] = (box, path, max(box[3] - box[0], box[4] - box[1], box[5] - box[2]), 0.0)
     if os.path.isdir(args.faults):
         for file in sorted(os.listdir(args.faults)):
             if not file.endswith(".ts"):
@@ -101,8 +104,9 @@ def cases(args):
             points, triangles = read_surface(path)
             box, extent = case_box(points)
             short = file.split("-")[3].split("_fault")[0] if file.count("-") >= 3 else file
-            found[short + "_z0"] = (box[:5] + [0.0], path, extent)
-            found[short + "_mean_top"] = (box[:5] + [mean_top(points, triangles)], path, extent)
+            for top_name, top in (("_z0", 0.0), ("_mean_top", mean_top(points, triangles))):
+                found[short + top_name] = (box[:5] + [top], path, extent, 0.0)
+                found[short + top_name + "_snap"] = (box[:5] + [top], path, extent, args.snap * extent)
     return found
 
 
@@ -118,12 +122,13 @@ def run(command):
     return done, time.time() - start
 
 
-def module_run(args, name, box, path, extent, divisor):
+def module_run(args, name, box, path, extent, snap, divisor):
     tool = os.path.join(args.build, "module", "meccano-immerse")
     stem = os.path.join(args.work, "%s_d%d" % (name, divisor))
     resolution = extent / divisor
     done, wall = run([tool, "--box", ",".join(repr(c) for c in box), "--surface", path + ":S", "--resolution",
-                      repr(resolution), "--output", stem + ".msh", "--report", stem + ".json"])
+                      repr(resolution), "--snap-to-box", repr(snap), "--output", stem + ".msh", "--report",
+                      stem + ".json"])
     row = {"status": done.returncode, "wall": wall, "retries": done.stdout.count("retrying")}
     if not add_insertion_figures(row, done, stem):
         return row
@@ -145,16 +150,17 @@ def main():
     parser.add_argument("--faults", default=os.path.join(HERE, "..", "..", "..", "shared", "data", "faults"))
     parser.add_argument("--divisors", default="30,50")
     parser.add_argument("--cases", default="")
+    parser.add_argument("--snap", type=float, default=1 / 200)
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
     print("| case | l_r | exit | tets | seconds (SUS) | retries | check | η min meccano / equilateral | dihedral "
           "| normal dev. max / mean | Hausdorff / E | area ratio |")
     print("|" + "---|" * 12)
-    for name, (box, path, extent) in cases(args).items():
+    for name, (box, path, extent, snap) in cases(args).items():
         if args.cases and name not in args.cases.split(","):
             continue
         for divisor in map(int, args.divisors.split(",")):
-            row = module_run(args, name, box, path, extent, divisor)
+            row = module_run(args, name, box, path, extent, snap, divisor)
             if row["status"] != 0:
                 print("| %s | E/%d | %d | – | %.1f | %d | – | %s |" % (name, divisor, row["status"], row["wall"],
                                                                     row["retries"], row["error"]), flush=True)

@@ -224,7 +224,7 @@ MatchedRim match_box_arcs(const TriangleSurface& surface, std::span<const int> s
                        " arcs where S's runs in " + std::to_string(m) + " (box planes of S's arcs: " +
                        describe_labels(surface_arcs.label) + "; of S_M's: " + describe_labels(arcs.label) +
                        "): where S's rim dips into the box and back by less than V_M's tets, S_M runs on along the "
-                       "box");
+                       "box (snap_rim_to_box, the tool's --snap-to-box, sets such a rim onto the box)");
   int rotation = -1;
   double best = std::numeric_limits<double>::infinity();
   for (int r = 0; r < m; ++r) {

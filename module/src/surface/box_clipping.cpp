@@ -137,4 +137,56 @@ std::vector<TriangleSurface> clip_to_box(const TriangleSurface& surface, const B
   return parts;
 }
 
+RimSnap snap_rim_to_box(TriangleSurface& surface, const Box& box, double distance) {
+  std::vector<std::vector<int>> rim_neighbours(surface.points.size());
+  const auto edges = detail::edges_with_triangles(surface.triangles);
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const bool shared = (i > 0 && edges[i - 1].first == edges[i].first) ||
+                        (i + 1 < edges.size() && edges[i + 1].first == edges[i].first);
+    if (shared) continue;
+    const auto [a, b] = edges[i].first;
+    rim_neighbours[a].push_back(b);
+    rim_neighbours[b].push_back(a);
+  }
+
+  std::vector<Eigen::Vector3d> snapped = surface.points;
+  RimSnap snap;
+  for (int axis = 0; axis < 3; ++axis)
+    for (const bool upper : {false, true}) {
+      const double offset = upper ? box.max[axis] : box.min[axis];
+      // How far inside the box a point lies from this plane (negative beyond it).
+      const auto depth = [&](const Eigen::Vector3d& p) { return upper ? offset - p[axis] : p[axis] - offset; };
+      for (std::size_t v = 0; v < surface.points.size(); ++v) {
+        const double d = depth(surface.points[v]);
+        if (d <= 0.0 || d > distance) continue;
+        // A rim edge that runs along the plane within 45° and ends within `distance` of it (or beyond).
+        const bool edge_near = std::ranges::any_of(rim_neighbours[v], [&](int w) {
+          const Eigen::Vector3d along = surface.points[static_cast<std::size_t>(w)] - surface.points[v];
+          const double across = std::abs(along[axis]);
+          return depth(surface.points[static_cast<std::size_t>(w)]) <= distance &&
+                 across * across <= along.squaredNorm() - across * across;
+        });
+        if (!edge_near) continue;
+        snapped[v][axis] = offset;
+        snap.largest_move = std::max(snap.largest_move, d);
+      }
+    }
+  for (std::size_t v = 0; v < snapped.size(); ++v) snap.vertices += snapped[v] != surface.points[v];
+
+  const auto normal = [](const std::vector<Eigen::Vector3d>& points, const std::array<int, 3>& t) {
+    return (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]).eval();
+  };
+  for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+    const auto& triangle = surface.triangles[t];
+    const auto moved = std::ranges::find_if(triangle, [&](int v) { return snapped[v] != surface.points[v]; });
+    if (moved == triangle.end() || normal(snapped, triangle).dot(normal(surface.points, triangle)) > 0.0) continue;
+    throw InputError(label(surface) + ": setting its rim onto the box within " + std::to_string(distance) +
+                     " turns triangle " + std::to_string(t) + " over or flattens it (vertex " + std::to_string(*moved) +
+                     " moves by " + std::to_string((snapped[*moved] - surface.points[*moved]).norm()) +
+                     "): give a smaller distance");
+  }
+  surface.points = std::move(snapped);
+  return snap;
+}
+
 }  // namespace meccano

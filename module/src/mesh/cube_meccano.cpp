@@ -4,6 +4,7 @@
 #include <meccano/mesh/bisection.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <sstream>
 
@@ -16,17 +17,12 @@ void check_box(const Box& box) {
 
 // Tags every face without a neighbour by the box side its vertices lie on.
 void tag_box_sides(TetMesh& mesh) {
-  const GridPoint upper = mesh.meccano.upper_corner();
   for (TetId t = 0; t < mesh.num_tets(); ++t)
     for (int f = 0; f < 4; ++f) {
       if (mesh.neighbours[t][f] != no_tet) continue;
-      for (int axis = 0; axis < 3; ++axis)
-        for (int upper_side = 0; upper_side < 2; ++upper_side) {
-          const std::int64_t plane = upper_side ? upper[axis] : 0;
-          const bool on_plane = std::all_of(face_vertices[f].begin(), face_vertices[f].end(),
-                                            [&](int local) { return mesh.grid[mesh.tets[t][local]][axis] == plane; });
-          if (on_plane) mesh.face_tags[t][f] = box_side_tag(static_cast<BoxSide>(2 * axis + upper_side));
-        }
+      unsigned shared = 0x3f;
+      for (const int local : face_vertices[f]) shared &= mesh.meccano.box_planes(mesh.grid[mesh.tets[t][local]]);
+      if (shared != 0) mesh.face_tags[t][f] = box_side_tag(static_cast<BoxSide>(std::countr_zero(shared)));
     }
 }
 

@@ -4,6 +4,7 @@
 
 #include "geometry/compensated_sum.hpp"
 
+#include <bit>
 #include <cmath>
 #include <sstream>
 
@@ -71,15 +72,10 @@ class Checker {
 
   // The box side (0..5) that all three grid points lie on, or -1.
   int box_side_of(const std::array<VertexId, 3>& face) const {
-    const GridPoint upper = mesh_.meccano.upper_corner();
-    for (int axis = 0; axis < 3; ++axis)
-      for (int upper_side = 0; upper_side < 2; ++upper_side) {
-        const std::int64_t plane = upper_side ? upper[axis] : 0;
-        if (mesh_.grid[face[0]][axis] == plane && mesh_.grid[face[1]][axis] == plane &&
-            mesh_.grid[face[2]][axis] == plane)
-          return 2 * axis + upper_side;
-      }
-    return -1;
+    const MeccanoGrid& grid = mesh_.meccano;
+    const unsigned shared = grid.box_planes(mesh_.grid[face[0]]) & grid.box_planes(mesh_.grid[face[1]]) &
+                            grid.box_planes(mesh_.grid[face[2]]);
+    return shared == 0 ? -1 : std::countr_zero(shared);
   }
 
   // Twice the area of a face lying on a plane normal to `axis`, exactly.

@@ -22,9 +22,20 @@ Eigen::Vector3d MeccanoGrid::to_physical(const GridPoint& g) const {
                                                 cell_size.z() * static_cast<double>(g[2]) * scale);
   // min + cells · (extent / cells) may round away from max: the upper box planes are exactly the box's,
   // as the surfaces clipped to them are.
+  const std::uint8_t planes = box_planes(g);
   for (int k = 0; k < 3; ++k)
-    if (g[k] == cells[k] * grid_cell) p[k] = box.max[k];
+    if (planes & (1u << (2 * k + 1))) p[k] = box.max[k];
   return p;
+}
+
+std::uint8_t MeccanoGrid::box_planes(const GridPoint& g) const {
+  const GridPoint upper = upper_corner();
+  std::uint8_t planes = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (g[axis] == 0) planes |= static_cast<std::uint8_t>(1u << (2 * axis));
+    if (g[axis] == upper[axis]) planes |= static_cast<std::uint8_t>(1u << (2 * axis + 1));
+  }
+  return planes;
 }
 
 GridPoint MeccanoGrid::upper_corner() const {

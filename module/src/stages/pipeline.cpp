@@ -839,7 +839,6 @@ std::unique_ptr<ParametricSurface> moved_parameterization(const ParametricSurfac
 void drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector<Eigen::Vector3d> displacement,
                      int rings) {
   const VertexTets stars = vertex_to_tets(mesh);
-  const GridPoint upper = mesh.meccano.upper_corner();
   std::vector<double> distance(mesh.points.size(), std::numeric_limits<double>::infinity());
   std::vector<VertexId> frontier, dragged;
   for (VertexId v = 0; v < mesh.num_vertices(); ++v)
@@ -884,8 +883,9 @@ void drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector
   for (const VertexId w : dragged) {
     if (!(distance[w] < reach)) continue;
     Eigen::Vector3d d = (1.0 - distance[w] / reach) * displacement[w];
+    const std::uint8_t planes = mesh.meccano.box_planes(mesh.grid[w]);
     for (int axis = 0; axis < 3; ++axis)
-      if (mesh.grid[w][axis] == 0 || mesh.grid[w][axis] == upper[axis]) d[axis] = 0.0;
+      if (planes & (3u << (2 * axis))) d[axis] = 0.0;
     mesh.points[w] += d;
   }
 }

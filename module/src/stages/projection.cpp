@@ -118,17 +118,6 @@ void take_parameters(SurfaceProjection& result, std::span<const std::array<int, 
   }
 }
 
-// The box planes a mesh node lies on, bits as box_sides (surface/box_clipping.hpp), from its exact grid point.
-std::uint8_t grid_box_planes(const TetMesh& mesh, VertexId v) {
-  const GridPoint upper = mesh.meccano.upper_corner();
-  std::uint8_t planes = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    if (mesh.grid[v][axis] == 0) planes |= static_cast<std::uint8_t>(1u << (2 * axis));
-    if (mesh.grid[v][axis] == upper[axis]) planes |= static_cast<std::uint8_t>(1u << (2 * axis + 1));
-  }
-  return planes;
-}
-
 // Every S_M node moves to φ of its parameters.
 void move_nodes_onto_surface(TetMesh& mesh, SurfaceProjection& result, const TriangleBVH& tree) {
   ProjectionStats& stats = result.stats;
@@ -139,7 +128,7 @@ void move_nodes_onto_surface(TetMesh& mesh, SurfaceProjection& result, const Tri
   for (std::int64_t i = 0; i < count; ++i) {
     const VertexId v = result.nodes[i];
     // A rim node on the box lands on S's rim on the same box planes: keep its coordinates there exact.
-    const std::uint8_t planes = grid_box_planes(mesh, v);
+    const std::uint8_t planes = mesh.meccano.box_planes(mesh.grid[v]);
     for (int axis = 0; axis < 3; ++axis)
       if (planes & (3u << (2 * axis))) moved[i][axis] = mesh.points[v][axis];
     stats.largest_move = std::max(stats.largest_move, (moved[i] - mesh.points[v]).norm());
@@ -424,7 +413,7 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
   const BoxArcs surface_arcs =
       box_arcs(planes, [&](int i) { return "S at its vertex " + std::to_string(surface_rim[i] + 1); });
   planes.clear();
-  for (int v : rim) planes.push_back(grid_box_planes(mesh, v));
+  for (int v : rim) planes.push_back(mesh.meccano.box_planes(mesh.grid[v]));
   const BoxArcs arcs = box_arcs(planes, [&](int i) { return "S_M at node " + std::to_string(rim[i]); });
 
   std::array<int, 4> surface_corners{}, approximation_corners{};

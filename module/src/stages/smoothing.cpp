@@ -323,13 +323,12 @@ class Smoother {
 };
 
 void Smoother::classify_nodes() {
-  const GridPoint upper = mesh_.meccano.upper_corner();
   freedom_.assign(mesh_.points.size(), {});
   for (VertexId v = 0; v < mesh_.num_vertices(); ++v) {
     NodeFreedom& node = freedom_[v];
+    const std::uint8_t planes = mesh_.meccano.box_planes(mesh_.grid[v]);
     for (int axis = 0; axis < 3; ++axis)
-      if (mesh_.grid[v][axis] == 0 || mesh_.grid[v][axis] == upper[axis])
-        node.free_axes &= static_cast<std::uint8_t>(~(1u << axis));
+      if (planes & (3u << (2 * axis))) node.free_axes &= static_cast<std::uint8_t>(~(1u << axis));
     if (node.free_axes == 0) node.kind = Freedom::fixed;
     else if (node.free_axes != 7) node.kind = Freedom::box;
   }

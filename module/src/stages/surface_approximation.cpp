@@ -30,12 +30,7 @@ bool edge_is_axis_parallel(const TetMesh& mesh, VertexId a, VertexId b) {
   return differing == 1;
 }
 
-bool on_box_boundary(const TetMesh& mesh, VertexId v) {
-  const GridPoint upper = mesh.meccano.upper_corner();
-  for (int k = 0; k < 3; ++k)
-    if (mesh.grid[v][k] == 0 || mesh.grid[v][k] == upper[k]) return true;
-  return false;
-}
+bool on_box_boundary(const TetMesh& mesh, VertexId v) { return mesh.meccano.box_planes(mesh.grid[v]) != 0; }
 
 // Squared length in computational coordinates; the lengths of a triangle's edges differ by factors
 // of at least sqrt(2) when they differ at all, far above rounding.

@@ -71,7 +71,7 @@ struct TetKind {
 };
 
 // The affine map from computational to physical coordinates of the undeformed meccano:
-// x = box.min + cell_size .* grid / grid_cell.
+// x = box.min + cell_size .* grid / grid_cell, and exactly box.max on the upper box planes.
 struct MeccanoGrid {
   Box box;
   std::array<int, 3> cells{1, 1, 1};
@@ -79,6 +79,9 @@ struct MeccanoGrid {
 
   Eigen::Vector3d to_physical(const GridPoint& g) const;
   GridPoint upper_corner() const;  // grid coordinates of box.max
+  // The box planes a grid point lies on, exactly: bit 2 axis for the lower plane, 2 axis + 1 for the upper
+  // one (the bit of BoxSide, and of box_sides in surface/box_clipping.hpp); 0 inside the box.
+  std::uint8_t box_planes(const GridPoint& g) const;
 };
 
 // A face of the mesh as a face of one of its tets: local_face f is the face opposite mesh.tets[tet][f]

@@ -260,6 +260,31 @@ TEST(ClippedSurface, ARealFaultWhoseTopDipsBelowTheBoxTopIsSnappedOntoIt) {
   expect_clipped_interface(insert(surface, box, extent / 30), surface, 0.01);
 }
 
+// A sheet whose edge comes within 0.004 of the box top without reaching it: its S_M meets the box, and the
+// finer retry's l_r is set by that gap. The retry's progress line says so and names the snap, before the
+// long run it starts (here stopped by the progress callback).
+TEST(ClippedSurface, ARetrySetByTheGapToTheBoxNamesTheSnap) {
+  const TriangleSurface sheet =
+      z_to_x(testing::graph_patch([](double y, double z) { return 0.4 + 0.1 * z + 0.02 * std::sin(4 * y); }, {0.2, 0.8},
+                                  {0.3, 0.996}, 12, "sheet"));
+  validate_surfaces({&sheet, 1}, kUnitBox);
+  struct Stopped {
+    std::string line;
+  };
+  InsertionOptions options;
+  options.resolution = 0.1;
+  options.progress = [](const std::string& line) {
+    if (line.find("retrying") != std::string::npos) throw Stopped{line};
+  };
+  try {
+    insert_surfaces(make_cube_meccano(kUnitBox, 0), {&sheet, 1}, options);
+    FAIL() << "no retry";
+  } catch (const Stopped& stopped) {
+    EXPECT_NE(stopped.line.find("set by its gap of 0.004"), std::string::npos) << stopped.line;
+    EXPECT_NE(stopped.line.find("--snap-to-box"), std::string::npos) << stopped.line;
+  }
+}
+
 // Through the tool: the surface file reaches beyond the box, the CLI clips it, and the written mesh
 // passes `check`; `measure` clips the surface to the mesh's box too, so the interface covers all of it.
 TEST(ClippedSurface, TheToolClipsChecksAndMeasures) {

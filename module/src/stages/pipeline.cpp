@@ -675,6 +675,14 @@ InsertionResult insert_surfaces(const TetMesh& mesh, std::span<const TriangleSur
     for (int s : refined) {
       resolutions[s] = finer_resolution(mesh.meccano, clearance, refined, s, previous[s]);
       finer << (finer.tellp() > 0 ? ", " : "") << surfaces[s].name << " at l_r = " << resolutions[s];
+      // A gap to the box that sets a much finer l_r is often a rim that should have reached the box: say so,
+      // as the run that follows may be long.
+      const bool box_gap_decides = std::ranges::all_of(
+          refined, [&](int other) { return other == s || clearance.to_box[s] <= clearance.between[s][other]; });
+      if (box_gap_decides && resolutions[s] < previous[s] / 2.0)
+        finer << " (set by its gap of " << clearance.to_box[s] << " to the box"
+              << (is_closed(surfaces[s]) ? "" : "; snap_rim_to_box, --snap-to-box, would set a rim that close onto it")
+              << ")";
     }
     for (std::size_t s = 0; s < surfaces.size(); ++s)
       estimate += estimate_tets(mesh.meccano, 0, surfaces.subspan(s, 1), resolutions[s]);

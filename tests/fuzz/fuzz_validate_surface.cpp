@@ -7,7 +7,11 @@
 // points on the box boundary. Raw doubles bring NaN, infinities and huge values. An index byte i gives
 // i - 4, so a few negative and out-of-range indices occur. validate_surfaces must either accept the set
 // or throw InputError; anything else (another exception, a sanitizer report, a hang) is a finding.
+// Then the same surfaces go the tool's way (module/cli/main.cpp): each disk's rim set onto the box within
+// 0.02 (snap_rim_to_box), clipped to the box (clip_to_box), the parts validated; InputError again is the
+// only acceptable failure. Surfaces with non-finite coordinates, which the readers refuse, skip that way.
 #include <meccano/error.hpp>
+#include <meccano/surface/box_clipping.hpp>
 #include <meccano/surface/validation.hpp>
 
 #include <array>
@@ -74,8 +78,21 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     surfaces.push_back(std::move(surface));
   }
   if (surfaces.empty()) return 0;
+  const meccano::Box box{Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()};
   try {
-    meccano::validate_surfaces(surfaces, meccano::Box{Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()});
+    meccano::validate_surfaces(surfaces, box);
+  } catch (const meccano::InputError&) {
+  }
+  try {
+    std::vector<meccano::TriangleSurface> inside;
+    for (meccano::TriangleSurface& surface : surfaces) {
+      for (const Eigen::Vector3d& p : surface.points)
+        if (!p.allFinite()) return 0;
+      meccano::require_surface_topology(surface);
+      meccano::snap_rim_to_box(surface, box, 0.02);
+      for (meccano::TriangleSurface& part : meccano::clip_to_box(surface, box)) inside.push_back(std::move(part));
+    }
+    meccano::validate_surfaces(inside, box);
   } catch (const meccano::InputError&) {
   }
   return 0;

@@ -12,7 +12,10 @@ Cases (each 21 positions, step 0 as given; --quick: 6):
   fault_translate  East Huasna (shared/data/faults) moved by l_r / 4 per step along its mean normal,
                    l_r = E / 50, E the largest extent of its bounding box;
   fault_rotate     the same fault turned by 1 degree per step about the vertical axis through its
-                   centroid (its far ends move by about 0.4 l_r per step).
+                   centroid (its far ends move by about 0.4 l_r per step);
+  sphere_grow      a closed surface: the inclusion's sphere (centre 0.5, radius 0.3, 4 608 triangles)
+                   growing by l_r / 4 per step, unit cube, level 12, l_r = 1/64. A closed surface is not
+                   moved yet (issue 20): every step is inserted anew, which this case measures.
 --fault FILE.ts moves another fault instead of East Huasna; --cases runs only the cases named.
 The faults' box holds every position: the bounding box of all of them grown by E / 10 on every side.
 
@@ -32,7 +35,9 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(HERE, "..", "..", "meshes"))
 from bench_faults import bounding_box, far_size, read_surface  # noqa: E402
+from generate_surfaces import octahedral_sphere  # noqa: E402
 from compare_references import interface_edge, moved_patch  # noqa: E402
 
 DEFAULT_FAULT = os.path.join(HERE, "..", "..", "..", "shared", "data", "faults",
@@ -66,6 +71,16 @@ def patch_steps(count, motion):
         points = moved_patch(0, 48)[0]
         positions = [[(x, y, z + k * resolution / 4) for x, y, z in points] for k in range(count)]
     return positions, moved_patch(0, 48)[1], "0,0,0,1,1,1", resolution, ["--level", "12"]
+
+
+def sphere_steps(count):
+    resolution = 1 / 64
+    positions = []
+    for k in range(count):
+        radius = 0.3 + k * resolution / 4
+        points, triangles = octahedral_sphere(lambda d: tuple(0.5 + radius * c for c in d), 24)
+        positions.append(points)
+    return positions, triangles, "0,0,0,1,1,1", resolution, ["--level", "12"]
 
 
 def fault_steps(fault, count, motion):
@@ -172,7 +187,7 @@ def main(argv):
     fault = argv[argv.index("--fault") + 1] if "--fault" in argv else DEFAULT_FAULT
     cases = {"patch_tilt": lambda: patch_steps(6, "tilt"), "patch_translate": lambda: patch_steps(count, "translate"),
              "fault_translate": lambda: fault_steps(fault, count, "translate"),
-             "fault_rotate": lambda: fault_steps(fault, count, "rotate")}
+             "fault_rotate": lambda: fault_steps(fault, count, "rotate"), "sphere_grow": lambda: sphere_steps(count)}
     if "--cases" in argv:
         cases = {name: cases[name] for name in argv[argv.index("--cases") + 1].split(",")}
     results = {}

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <sstream>
 #include <string>
 
 namespace meccano {
@@ -180,10 +181,11 @@ RimSnap snap_rim_to_box(TriangleSurface& surface, const Box& box, double distanc
     const auto& triangle = surface.triangles[t];
     const auto moved = std::ranges::find_if(triangle, [&](int v) { return snapped[v] != surface.points[v]; });
     if (moved == triangle.end() || normal(snapped, triangle).dot(normal(surface.points, triangle)) > 0.0) continue;
-    throw InputError(label(surface) + ": setting its rim onto the box within " + std::to_string(distance) +
-                     " turns triangle " + std::to_string(t) + " over or flattens it (vertex " + std::to_string(*moved) +
-                     " moves by " + std::to_string((snapped[*moved] - surface.points[*moved]).norm()) +
-                     "): give a smaller distance");
+    std::ostringstream message;  // 1-based numbers, as in the surface files and the other messages
+    message << label(surface) << ": setting its rim onto the box within " << distance << " turns triangle " << t + 1
+            << " over or flattens it (vertex " << *moved + 1 << " moves by "
+            << (snapped[*moved] - surface.points[*moved]).norm() << "): give a smaller distance";
+    throw InputError(message.str());
   }
   surface.points = std::move(snapped);
   return snap;

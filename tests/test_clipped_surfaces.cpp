@@ -315,5 +315,40 @@ TEST(ClippedSurface, TheToolClipsChecksAndMeasures) {
   std::filesystem::remove_all(work);
 }
 
+// Through the tool: a sheet whose top edge zigzags across the box top, 0.015 below it at every other
+// vertex, less than the tets at l_r = 0.08 (and at the retries' 0.04 and 0.02). Without --snap-to-box the
+// insertion fails and names the option; with --snap-to-box 0.02 the rim runs on the top and `check` passes.
+TEST(ClippedSurface, TheToolSnapsARimThatDipsBelowTheTop) {
+  const std::filesystem::path work =
+      std::filesystem::temp_directory_path() / ("meccano-snapped-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(work);
+  TriangleSurface sheet = z_to_x(testing::graph_patch(
+      [](double y, double z) { return 0.4 + 0.1 * z + 0.02 * std::sin(4 * y); }, {0.2, 0.8}, {0.3, 1.0}, 12, "sheet"));
+  std::vector<int> top;
+  for (int v = 0; v < static_cast<int>(sheet.points.size()); ++v)
+    if (sheet.points[v].z() == 1.0) top.push_back(v);
+  std::ranges::sort(top, {}, [&](int v) { return sheet.points[v].y(); });
+  ASSERT_EQ(top.size(), 13u);
+  for (std::size_t i = 0; i < top.size(); ++i) sheet.points[top[i]].z() = i % 2 == 0 ? 1.03 : 0.985;
+  const std::string surface = testing::write_obj((work / "sheet.obj").string(), sheet);
+  const std::string insert = std::string(MECCANO_CLI) + " --box 0,0,0,1,1,1 --resolution 0.08 --surface " + surface +
+                             ":sheet --output " + (work / "sheet.msh").string();
+
+  const testing::CommandRun dipping = testing::run_command(insert + " --quiet");
+  EXPECT_EQ(dipping.status, 1) << dipping.output;
+  EXPECT_NE(dipping.output.find("--snap-to-box"), std::string::npos) << dipping.output;
+  EXPECT_FALSE(std::filesystem::exists(work / "sheet.msh"));
+
+  const testing::CommandRun snapped = testing::run_command(insert + " --snap-to-box 0.02");
+  ASSERT_EQ(snapped.status, 0) << snapped.output;
+  EXPECT_NE(snapped.output.find("6 rim vertices set onto the box (--snap-to-box), moved by up to 0.015"),
+            std::string::npos)
+      << snapped.output;
+  const testing::CommandRun check =
+      testing::run_command(std::string(MECCANO_CLI) + " check " + (work / "sheet.msh").string());
+  EXPECT_EQ(check.status, 0) << check.output;
+  std::filesystem::remove_all(work);
+}
+
 }  // namespace
 }  // namespace meccano

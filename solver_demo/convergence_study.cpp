@@ -100,8 +100,7 @@ meccano::DealiiMesh module_mesh(const Level& level, const meccano::TriangleSurfa
   const auto start = std::chrono::steady_clock::now();
   const meccano::Box box{{0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}};
   // The part of S inside the box (the fault's triangulation runs above the top), as the CLI inserts it.
-  const std::vector<meccano::TriangleSurface> surfaces =
-      meccano::reaches_box(surface, box) ? meccano::clip_to_box(surface, box) : std::vector{surface};
+  const std::vector<meccano::TriangleSurface> surfaces = meccano::clip_to_box(surface, box);
   meccano::validate_surfaces(surfaces, box);
   meccano::InsertionOptions options;
   options.resolution = level.resolution;

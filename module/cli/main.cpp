@@ -448,9 +448,7 @@ std::vector<meccano::TriangleSurface> clipped_to_box(std::vector<meccano::Triang
       const meccano::RimSnap snap = meccano::snap_rim_to_box(surface, box, options.snap_to_box);
       if (snap.vertices > 0)
         progress.say("surface ", surface.name, ": ", snap.vertices,
-                     " rim vertices set onto the box (--snap-to-box), "
-                     "moved by up to ",
-                     snap.largest_move);
+                     " rim vertices set onto the box (--snap-to-box), moved by up to ", snap.largest_move);
     }
     if (!meccano::reaches_box(surface, box)) {
       inside.push_back(std::move(surface));

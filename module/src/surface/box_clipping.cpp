@@ -139,13 +139,10 @@ std::vector<TriangleSurface> clip_to_box(const TriangleSurface& surface, const B
 }
 
 RimSnap snap_rim_to_box(TriangleSurface& surface, const Box& box, double distance) {
+  detail::TopologyScratch scratch;
+  detail::triangle_topology(surface.triangles, scratch);
   std::vector<std::vector<int>> rim_neighbours(surface.points.size());
-  const auto edges = detail::edges_with_triangles(surface.triangles);
-  for (std::size_t i = 0; i < edges.size(); ++i) {
-    const bool shared = (i > 0 && edges[i - 1].first == edges[i].first) ||
-                        (i + 1 < edges.size() && edges[i + 1].first == edges[i].first);
-    if (shared) continue;
-    const auto [a, b] = edges[i].first;
+  for (const auto& [a, b] : scratch.boundary) {
     rim_neighbours[a].push_back(b);
     rim_neighbours[b].push_back(a);
   }

@@ -16,7 +16,6 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <map>
 #include <numbers>
 #include <vector>
 
@@ -36,12 +35,8 @@ double area(const TriangleSurface& s) {
 
 // Rim vertices lie on box planes exactly or inside; interior vertices strictly inside.
 void expect_rim_on_box_planes(const TriangleSurface& s, const Box& box) {
-  std::map<std::pair<int, int>, int> uses;
-  for (const auto& t : s.triangles)
-    for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
   std::vector<std::uint8_t> rim(s.points.size(), 0);
-  for (const auto& [edge, n] : uses)
-    if (n == 1) rim[edge.first] = rim[edge.second] = 1;
+  for (const auto& [a, b] : testing::rim_edges(s)) rim[a] = rim[b] = 1;
   for (std::size_t v = 0; v < s.points.size(); ++v) {
     const Eigen::Array3d p = s.points[v].array();
     EXPECT_TRUE((p >= box.min.array()).all() && (p <= box.max.array()).all()) << v;

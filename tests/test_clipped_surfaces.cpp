@@ -217,18 +217,15 @@ TEST(ClippedSurface, RealFaultsCutByTheGround) {
 // The mean elevation of the rim vertices in the top tenth of the surface's height (tests/bench/
 // clipped_surfaces.py's "mean top").
 double mean_top(const TriangleSurface& surface) {
-  std::map<std::pair<int, int>, int> uses;
-  for (const auto& t : surface.triangles)
-    for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
   double low = surface.points[0].z(), high = low;
   for (const Eigen::Vector3d& p : surface.points) {
     low = std::min(low, p.z());
     high = std::max(high, p.z());
   }
   std::set<int> top;
-  for (const auto& [edge, n] : uses)
-    for (const int v : {edge.first, edge.second})
-      if (n == 1 && surface.points[v].z() >= high - 0.1 * (high - low)) top.insert(v);
+  for (const auto& [a, b] : testing::rim_edges(surface))
+    for (const int v : {a, b})
+      if (surface.points[v].z() >= high - 0.1 * (high - low)) top.insert(v);
   double sum = 0.0;
   for (const int v : top) sum += surface.points[v].z();
   return sum / static_cast<double>(top.size());

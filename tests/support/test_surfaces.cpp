@@ -312,21 +312,26 @@ std::vector<SurfaceCase> surface_cases(int n, bool with_perturbed) {
   return all;
 }
 
-double distance_to_rim(const TriangleSurface& surface, const Eigen::Vector3d& x) {
-  std::vector<std::pair<int, int>> edges;
+std::vector<std::pair<int, int>> rim_edges(const TriangleSurface& surface) {
+  std::vector<std::pair<int, int>> edges, rim;
   for (const auto& t : surface.triangles)
     for (int k = 0; k < 3; ++k) edges.push_back(std::minmax(t[k], t[(k + 1) % 3]));
   std::sort(edges.begin(), edges.end());
-  double best = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i + 1;
     while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if (j - i == 1) {
-      const Eigen::Vector3d a = surface.points[edges[i].first], b = surface.points[edges[i].second];
-      const double s = std::clamp((x - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
-      best = std::min(best, (a + s * (b - a) - x).norm());
-    }
+    if (j - i == 1) rim.push_back(edges[i]);
     i = j;
+  }
+  return rim;
+}
+
+double distance_to_rim(const TriangleSurface& surface, const Eigen::Vector3d& x) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& [first, second] : rim_edges(surface)) {
+    const Eigen::Vector3d a = surface.points[first], b = surface.points[second];
+    const double s = std::clamp((x - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (a + s * (b - a) - x).norm());
   }
   return best;
 }

@@ -57,7 +57,9 @@ struct NamedSurfaces {
 // patch (irregular triangles).
 std::vector<NamedSurfaces> named_test_surfaces(int n);
 
-// Distance from x to the rim polyline of a surface (its edges used by one triangle).
+// The rim edges of a surface (its edges used by one triangle), each as (smaller, larger) vertex, sorted.
+std::vector<std::pair<int, int>> rim_edges(const TriangleSurface& surface);
+// Distance from x to the rim polyline of a surface.
 double distance_to_rim(const TriangleSurface& surface, const Eigen::Vector3d& x);
 
 // A case of the stage tests: surfaces (inserted in order) in a box at a resolution.

@@ -11,6 +11,7 @@
 #include <meccano/mesh/invariants.hpp>
 #include <meccano/mesh/quality.hpp>
 #include <meccano/stages/pipeline.hpp>
+#include <meccano/stages/sequence.hpp>
 #include <meccano/surface/box_clipping.hpp>
 #include <meccano/surface/validation.hpp>
 
@@ -197,6 +198,38 @@ TEST(ClippedSurface, FaultsLeavingThroughOneTwoAndThreeFaces) {
     expect_clipped_interface(result, surface, 0.01);
     EXPECT_FALSE(divided_sides(result, 0).has_value()) << "its lower rim runs inside the box";
   }
+}
+
+// A fault through the box top, moving. Given clipped at each step, it keeps its triangulation while it
+// moves along the top (no vertex crosses the plane), and each step is moved from the previous one: the
+// interface stays on S and its rim on the top, and the box nodes on their planes. A step down across a
+// row of vertices changes the clipped triangulation, and that step is inserted anew.
+TEST(ClippedSurface, AFaultThroughTheTopIsMovedAlongIt) {
+  // x = 0.45 + 0.1 z + 0.03 sin(5 y) over y in [0.2, 0.8], z in [0.3, 1.2]: rows of vertices 0.0375 apart
+  // in z, one at 1.0125.
+  const auto fault = [](const Eigen::Vector3d& by) {
+    TriangleSurface surface =
+        z_to_x(testing::graph_patch([](double y, double z) { return 0.45 + 0.1 * z + 0.03 * std::sin(5 * y); },
+                                    {0.2, 0.8}, {0.3, 1.2}, 24, "fault"));
+    for (Eigen::Vector3d& p : surface.points) p += by;
+    return clipped(surface, kUnitBox);
+  };
+  constexpr double resolution = 0.07;
+  InsertionOptions options;
+  options.resolution = resolution;
+  SurfaceSequence sequence(make_cube_meccano(kUnitBox, 0), options);
+  for (int step = 0; step < 3; ++step) {
+    const TriangleSurface surface = fault({step * resolution / 4, step * resolution / 8, 0.0});
+    const SequenceStep& done = sequence.advance({surface});
+    SCOPED_TRACE("step " + std::to_string(step) + ": " + done.inserted_because);
+    EXPECT_EQ(done.kind, step == 0 ? StepKind::inserted : StepKind::moved);
+    expect_clipped_interface(done.result, surface, 0.01);
+  }
+  const TriangleSurface lowered = fault({0.5 * resolution, 0.25 * resolution, -0.02});
+  const SequenceStep& done = sequence.advance({lowered});
+  EXPECT_EQ(done.kind, StepKind::inserted);
+  EXPECT_NE(done.inserted_because.find("triangulation of fault changed"), std::string::npos) << done.inserted_because;
+  expect_clipped_interface(done.result, lowered, 0.01);
 }
 
 // Real faults reach the ground: in their box with its top at elevation 0, they are clipped there.

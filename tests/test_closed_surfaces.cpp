@@ -27,6 +27,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -217,34 +218,81 @@ TEST(ClosedSurface, ASphereTouchingTheBoxIsRefused) {
   EXPECT_THROW(validate_surfaces({&surface, 1}, kUnitBox), InputError);
 }
 
-TEST(ClosedSurface, MovingOneIsRefusedWithAReason) {
+// `surface` grown about the sphere's centre (0.5, 0.5, 0.5) by `factor`.
+TriangleSurface grown(TriangleSurface surface, double factor) {
+  const Eigen::Vector3d centre(0.5, 0.5, 0.5);
+  for (Eigen::Vector3d& p : surface.points) p = centre + factor * (p - centre);
+  return surface;
+}
+
+TriangleSurface shifted(TriangleSurface surface, const Eigen::Vector3d& by) {
+  for (Eigen::Vector3d& p : surface.points) p += by;
+  return surface;
+}
+
+// A cut replayed on the moved points puts each crossing on the same edge at the same fraction, so the
+// parts keep their triangles wherever the points went.
+TEST(ClosedSurface, ACutIsReplayedOnTheMovedPoints) {
   const TriangleSurface surface = testing::sphere(8);
-  const InsertionResult result = insert({&surface, 1}, kUnitBox, 0.1);
-  InsertionOptions options;
-  options.resolution = 0.1;
-  try {
-    move_surfaces(result, {&surface, 1}, options);
-    FAIL() << "a closed surface was moved";
-  } catch (const InputError& error) {
-    EXPECT_THAT(error.what(), HasSubstr("moving a closed surface is not supported"));
+  const std::optional<PlaneCut> cut = cut_by_plane(surface, 2, 0.53);
+  ASSERT_TRUE(cut);
+  ASSERT_FALSE(cut->crossings.empty());
+  ASSERT_EQ(cut->points.size(), surface.points.size() + cut->crossings.size());
+  EXPECT_EQ(crossing_points(surface.points, cut->crossings), cut->points);
+
+  const TriangleSurface moved = grown(surface, 1.1);
+  const std::vector<Eigen::Vector3d> replayed = crossing_points(moved.points, cut->crossings);
+  ASSERT_EQ(replayed.size(), cut->points.size());
+  for (std::size_t i = 0; i < cut->crossings.size(); ++i) {
+    const EdgeCrossing& at = cut->crossings[i];
+    const Eigen::Vector3d& a = moved.points[at.low];
+    const Eigen::Vector3d& b = moved.points[at.high];
+    const Eigen::Vector3d& x = replayed[surface.points.size() + i];
+    EXPECT_LT((x - a).cross(b - a).norm(), 1e-12) << "crossing " << i << " off its edge";
+    EXPECT_NEAR((x - a).norm() / (b - a).norm(), at.fraction, 1e-12);
+    EXPECT_GT(at.fraction, 0.0);
+    EXPECT_LT(at.fraction, 1.0);
   }
 }
 
-// A sequence inserts each step of a closed surface anew, says why, and every step is a valid inclusion.
-TEST(ClosedSurface, ASequenceInsertsEachStepAnew) {
+// A closed surface moved (grown, then shifted) from the previous result: its two halves are cut as they
+// were and the interface lands on the moved surface, a closed sphere enclosing its volume; the tets are
+// the previous ones.
+TEST(ClosedSurface, MovingOneCutsItAlikeAndLandsOnTheMovedSurface) {
+  const TriangleSurface surface = testing::sphere(8);
+  const InsertionResult inserted = insert({&surface, 1}, kUnitBox, 0.1);
+  ASSERT_EQ(inserted.surfaces.front().projections.size(), 2u);
+  InsertionOptions options;
+  options.resolution = 0.1;
+  for (const TriangleSurface& moved_surface :
+       {grown(surface, 1.08), grown(surface, 0.93), shifted(surface, {0.01, -0.02, 0.015})}) {
+    const InsertionResult moved = move_surfaces(inserted, {&moved_surface, 1}, options);
+    EXPECT_EQ(moved.mesh.tets, inserted.mesh.tets);
+    ASSERT_EQ(moved.surfaces.front().projections.size(), 2u);
+    EXPECT_GT(moved.surfaces.front().projection_stats().largest_move, 0.01);
+    expect_closed_interface(moved, moved_surface, 0, 0.05);
+  }
+}
+
+// A growing sphere, a quarter of l_r per step: the steps are moved, not inserted anew, and each is a valid
+// inclusion whose nodes away from it keep their places.
+TEST(ClosedSurface, ASequenceMovesAGrowingSphere) {
   InsertionOptions options;
   options.resolution = 0.1;
   SurfaceSequence sequence(make_cube_meccano(kUnitBox, 0), options);
-  TriangleSurface surface = testing::sphere(8);
-  for (int step = 0; step < 2; ++step) {
+  const TriangleSurface sphere = testing::sphere(8);  // radius 0.3
+  int moved = 0;
+  for (int step = 0; step < 4; ++step) {
+    const TriangleSurface surface = grown(sphere, 1.0 + step * 0.025 / 0.3);
     const SequenceStep& done = sequence.advance({surface});
-    EXPECT_EQ(done.kind, StepKind::inserted);
-    if (step > 0) {
-      EXPECT_THAT(done.inserted_because, HasSubstr("sphere is closed"));
-    }
+    SCOPED_TRACE("step " + std::to_string(step) + ": " + done.inserted_because);
+    moved += done.kind == StepKind::moved;
     expect_closed_interface(done.result, surface, 0, 0.05);
-    for (Eigen::Vector3d& p : surface.points) p.z() += 0.02;
+    if (step > 0) {
+      EXPECT_GT(done.nodes_unchanged, 0);
+    }
   }
+  EXPECT_GE(moved, 2);
 }
 
 }  // namespace

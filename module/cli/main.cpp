@@ -158,7 +158,7 @@ min/mean/std, inverted, min_dihedral_deg, max_dihedral_deg, and the step's whole
 `insertion`) and the total `seconds`. A step whose surfaces keep their triangulations is made from the
 previous step's mesh: its interface moves onto them and the rings of nodes around it follow (mode
 "moved"); it is inserted into the meccano mesh anew (mode "inserted", with `inserted_because`) when a
-triangulation changed, when a vertex moved farther than --max-move l_r (default 1), or when the moved
+triangulation changed (a surface clipped by the box changes it when a vertex crosses a box plane), when a vertex moved farther than --max-move l_r (default 1), or when the moved
 mesh stays tangled or its worst tet falls more than --max-quality-loss (default 0.02, either mean ratio)
 below what the insertions gave. --from-scratch inserts every step anew.
 

@@ -906,13 +906,6 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
   if (surfaces.size() != previous.surfaces.size())
     throw InputError(std::to_string(surfaces.size()) + " surfaces to move, but the previous step inserted " +
                      std::to_string(previous.surfaces.size()));
-  for (const TriangleSurface& surface : surfaces) {
-    if (is_closed(surface))
-      throw InputError(surface.name + ": moving a closed surface is not supported yet; insert each step anew");
-    if (reaches_box(surface, previous.mesh.meccano.box))
-      throw InputError(surface.name + ": moving a surface clipped by the box is not supported yet; insert each "
-                                      "step anew");
-  }
   const ThreadCount threads(options.threads);
   InsertionResult result;
   result.mesh = previous.mesh;
@@ -928,36 +921,39 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
     moved.volumetric = was.volumetric;
     moved.volumetric_stats = was.volumetric_stats;
     moved.healing_stats = was.healing_stats;
-    const SurfaceProjection& from = was.projections.front();
-    SurfaceProjection& to = moved.projections.emplace_back();
-    to.surface_index = from.surface_index;
-    to.surface = moved_parameterization(*from.surface, split_rim_chords(surfaces[s]));
-    to.nodes = from.nodes;
-    to.uv = from.uv;
-    to.on_rim = from.on_rim;
-    to.triangles = from.triangles;
-    to.orientation = from.orientation;
-    to.creases = from.creases;
-    to.stats.nodes = from.stats.nodes;
-    to.stats.rim_nodes = from.stats.rim_nodes;
-    to.stats.creases = from.stats.creases;
-    for (std::size_t i = 0; i < to.nodes.size(); ++i) {
-      Eigen::Vector3d& node = result.mesh.points[to.nodes[i]];
-      const Eigen::Vector3d on_surface = to.surface->evaluate(to.surface->locate(to.uv[i]));
-      displacement[to.nodes[i]] = on_surface - node;
-      moved_node[to.nodes[i]] = 1;
-      to.stats.largest_move = std::max(to.stats.largest_move, (on_surface - node).norm());
-      node = on_surface;
+    moved.closed = was.closed;
+    moved.rim_on_box = was.rim_on_box;
+    const TriangleBVH tree(surfaces[s]);
+    for (const SurfaceProjection& from : was.projections) {  // one disk, or a closed surface's two halves
+      SurfaceProjection& to = moved.projections.emplace_back();
+      to.surface_index = from.surface_index;
+      to.surface = moved_parameterization(*from.surface, projection_target(from, surfaces[s]));
+      to.nodes = from.nodes;
+      to.uv = from.uv;
+      to.on_rim = from.on_rim;
+      to.triangles = from.triangles;
+      to.orientation = from.orientation;
+      to.creases = from.creases;
+      to.cut_crossings = from.cut_crossings;
+      to.cut_triangles = from.cut_triangles;
+      to.stats.rim_nodes = from.stats.rim_nodes;
+      to.stats.creases = from.stats.creases;
+      move_nodes_onto_surface(result.mesh, to, tree);
     }
+    for (const SurfaceProjection& to : moved.projections)
+      for (const VertexId v : to.nodes) {
+        displacement[v] = result.mesh.points[v] - previous.mesh.points[v];
+        moved_node[v] = 1;
+      }
     moved.projection_seconds = seconds_since(moving);
   }
   drag_neighbours(result.mesh, std::move(moved_node), std::move(displacement), move.drag_rings);
   const std::int64_t inverted = count_inverted(result.mesh);
   for (SurfaceInsertion& moved : result.surfaces) {
-    SurfaceProjection& projection = moved.projections.front();
-    projection.stats.inverted_tets = inverted;
-    report(options, "moved ", moved.name, ": ", projection.nodes.size(), " S_M nodes by up to ",
-           projection.stats.largest_move, "; ", inverted, " tets inverted");
+    for (SurfaceProjection& projection : moved.projections) projection.stats.inverted_tets = inverted;
+    const ProjectionStats stats = moved.projection_stats();
+    report(options, "moved ", moved.name, ": ", stats.nodes, " S_M nodes by up to ", stats.largest_move, "; ", inverted,
+           " tets inverted");
   }
   result.quality_before_smoothing = summarize_quality(result.mesh);
   // In a band, the improvement (and SUS, if it runs) reaches every node that followed the interface.

@@ -118,26 +118,6 @@ void take_parameters(SurfaceProjection& result, std::span<const std::array<int, 
   }
 }
 
-// Every S_M node moves to φ of its parameters.
-void move_nodes_onto_surface(TetMesh& mesh, SurfaceProjection& result, const TriangleBVH& tree) {
-  ProjectionStats& stats = result.stats;
-  const auto count = static_cast<std::int64_t>(result.nodes.size());
-  std::vector<Eigen::Vector3d> moved(result.nodes.size());
-#pragma omp parallel for schedule(dynamic, 256)
-  for (std::int64_t i = 0; i < count; ++i) moved[i] = result.surface->evaluate(result.surface->locate(result.uv[i]));
-  for (std::int64_t i = 0; i < count; ++i) {
-    const VertexId v = result.nodes[i];
-    // A rim node on the box lands on S's rim on the same box planes: keep its coordinates there exact.
-    const std::uint8_t planes = mesh.meccano.box_planes(mesh.grid[v]);
-    for (int axis = 0; axis < 3; ++axis)
-      if (planes & (3u << (2 * axis))) moved[i][axis] = mesh.points[v][axis];
-    stats.largest_move = std::max(stats.largest_move, (moved[i] - mesh.points[v]).norm());
-    mesh.points[v] = moved[i];
-    stats.largest_distance_after =
-        std::max(stats.largest_distance_after, std::sqrt(tree.closest_point(moved[i]).squared_distance));
-  }
-  stats.nodes = count;
-}
 
 // One disk of S_M (`triangles`, over the mesh's numbering, oriented like S) onto one disk of S (`target`,
 // parameterized), with S_M's corners and anchors given: steps 1-3 once the corners are chosen. `pulled`
@@ -311,6 +291,8 @@ bool is_disk_without_chords(std::span<const std::array<int, 3>> triangles) {
 struct ClosedCut {
   std::array<std::vector<std::array<int, 3>>, 2> approximation;  // S_M's halves, over the mesh's numbering
   std::array<TriangleSurface, 2> surface;                        // S's halves over one point array
+  std::vector<EdgeCrossing> crossings;                           // the cut's points on S's edges
+  std::array<std::vector<std::array<int, 3>>, 2> cut_triangles;  // S's halves before their chords were split
 };
 
 // S_M cut by the computational plane grid[axis] = level: each triangle goes to the side of its
@@ -337,23 +319,31 @@ std::optional<std::array<std::vector<std::array<int, 3>>, 2>> cut_approximation(
   return halves;
 }
 
-// S cut by the physical plane x[axis] = offset into two disks, each with its rim chords split (a vertex
-// of S on the plane can leave one); empty if the plane cuts S in more than one loop, or along a triangle.
-std::optional<std::array<TriangleSurface, 2>> cut_surface(const TriangleSurface& surface, int axis, double offset) {
-  const std::optional<PlaneCut> cut = cut_by_plane(surface, axis, offset);
+// One half of `surface` over the points of its cut, with its rim chords split (a vertex of S on the cut
+// can leave one).
+TriangleSurface surface_half(const TriangleSurface& surface, std::vector<Eigen::Vector3d> points,
+                             std::vector<std::array<int, 3>> triangles) {
+  TriangleSurface half;
+  half.name = surface.name;
+  half.source = surface.source;
+  half.points = std::move(points);
+  half.triangles = std::move(triangles);
+  return split_rim_chords(half);
+}
+
+// S cut by the physical plane x[axis] = offset into two disks; empty if the plane cuts S in more than one
+// loop, or along a triangle.
+std::optional<PlaneCut> cut_surface(const TriangleSurface& surface, int axis, double offset,
+                                    std::array<TriangleSurface, 2>& halves) {
+  std::optional<PlaneCut> cut = cut_by_plane(surface, axis, offset);
   if (!cut) return std::nullopt;
-  std::array<TriangleSurface, 2> halves;
   for (int half = 0; half < 2; ++half) {
-    TriangleSurface& part = halves[half];
-    part.name = surface.name;
-    part.source = surface.source;
-    part.points = cut->points;
-    part.triangles = half == 0 ? cut->below : cut->above;
-    if (part.triangles.empty()) return std::nullopt;
-    part = split_rim_chords(part);
-    if (!is_disk_without_chords(part.triangles)) return std::nullopt;
+    const auto& triangles = half == 0 ? cut->below : cut->above;
+    if (triangles.empty()) return std::nullopt;
+    halves[half] = surface_half(surface, cut->points, triangles);
+    if (!is_disk_without_chords(halves[half].triangles)) return std::nullopt;
   }
-  return halves;
+  return cut;
 }
 
 // The coordinate plane through S_M's nodes nearest to the middle of S_M along some axis that cuts both
@@ -384,9 +374,13 @@ ClosedCut cut_closed_surface(const TetMesh& mesh, std::span<const std::array<int
     auto approximation = cut_approximation(mesh, triangles, c.axis, c.level);
     if (!approximation) continue;
     const double offset = mesh.meccano.to_physical(GridPoint{c.level, c.level, c.level})[c.axis];
-    auto halves = cut_surface(surface, c.axis, offset);
-    if (!halves) continue;
-    return {std::move(*approximation), std::move(*halves)};
+    ClosedCut closed;
+    closed.approximation = std::move(*approximation);
+    std::optional<PlaneCut> cut = cut_surface(surface, c.axis, offset, closed.surface);
+    if (!cut) continue;
+    closed.crossings = std::move(cut->crossings);
+    closed.cut_triangles = {std::move(cut->below), std::move(cut->above)};
+    return closed;
   }
   throw MeshingError("no coordinate plane through the nodes of S_M cuts both S_M and the closed surface into two "
                      "disks (" +
@@ -394,6 +388,27 @@ ClosedCut cut_closed_surface(const TetMesh& mesh, std::span<const std::array<int
 }
 
 }  // namespace
+
+void move_nodes_onto_surface(TetMesh& mesh, SurfaceProjection& projection, const TriangleBVH& tree) {
+  ProjectionStats& stats = projection.stats;
+  const auto count = static_cast<std::int64_t>(projection.nodes.size());
+  std::vector<Eigen::Vector3d> moved(projection.nodes.size());
+#pragma omp parallel for schedule(dynamic, 256)
+  for (std::int64_t i = 0; i < count; ++i)
+    moved[i] = projection.surface->evaluate(projection.surface->locate(projection.uv[i]));
+  for (std::int64_t i = 0; i < count; ++i) {
+    const VertexId v = projection.nodes[i];
+    // A rim node on the box lands on S's rim on the same box planes: keep its coordinates there exact.
+    const std::uint8_t planes = mesh.meccano.box_planes(mesh.grid[v]);
+    for (int axis = 0; axis < 3; ++axis)
+      if (planes & (3u << (2 * axis))) moved[i][axis] = mesh.points[v][axis];
+    stats.largest_move = std::max(stats.largest_move, (moved[i] - mesh.points[v]).norm());
+    mesh.points[v] = moved[i];
+    stats.largest_distance_after =
+        std::max(stats.largest_distance_after, std::sqrt(tree.closest_point(moved[i]).squared_distance));
+  }
+  stats.nodes = count;
+}
 
 SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index, int side,
                                        const TriangleSurface& surface, const TriangleBVH& tree,
@@ -466,11 +481,18 @@ std::vector<SurfaceProjection> project_closed_onto_surface(TetMesh& mesh, const 
                                   parameterize_to_square(cut.surface[half], surface_corners, options.weights), pulled,
                                   approximation_corners, {}, tree, options));
   const std::int64_t inverted = count_inverted(mesh);
-  for (SurfaceProjection& half : halves) {
-    half.surface_index = index;
-    half.stats.inverted_tets = inverted;
+  for (int half = 0; half < 2; ++half) {
+    halves[half].surface_index = index;
+    halves[half].stats.inverted_tets = inverted;
+    halves[half].cut_crossings = cut.crossings;
+    halves[half].cut_triangles = cut.cut_triangles[half];
   }
   return halves;
+}
+
+TriangleSurface projection_target(const SurfaceProjection& projection, const TriangleSurface& surface) {
+  if (projection.cut_triangles.empty()) return split_rim_chords(surface);
+  return surface_half(surface, crossing_points(surface.points, projection.cut_crossings), projection.cut_triangles);
 }
 
 }  // namespace meccano

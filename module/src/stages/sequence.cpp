@@ -2,8 +2,6 @@
 
 #include <meccano/error.hpp>
 #include <meccano/mesh/node_correspondence.hpp>
-#include <meccano/surface/box_clipping.hpp>
-#include <meccano/surface/closed_surface.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -32,9 +30,6 @@ std::string SurfaceSequence::why_not_moved(const std::vector<TriangleSurface>& s
   if (surfaces.size() != surfaces_.size()) return "the number of surfaces changed";
   for (std::size_t s = 0; s < surfaces.size(); ++s) {
     if (surfaces[s].name != surfaces_[s].name) return "surface " + std::to_string(s + 1) + " was renamed";
-    if (is_closed(surfaces[s])) return surfaces[s].name + " is closed (move_surfaces does not move closed surfaces)";
-    if (reaches_box(surfaces[s], meccano_.meccano.box))
-      return surfaces[s].name + " is clipped by the box (move_surfaces does not move such surfaces)";
     if (surfaces[s].points.size() != surfaces_[s].points.size() || surfaces[s].triangles != surfaces_[s].triangles)
       return "the triangulation of " + surfaces[s].name + " changed";
     double farthest = 0.0;

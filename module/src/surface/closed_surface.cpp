@@ -34,6 +34,22 @@ TriangleSurface oriented_outward(TriangleSurface surface) {
   return surface;
 }
 
+namespace {
+
+Eigen::Vector3d on_edge(std::span<const Eigen::Vector3d> points, const EdgeCrossing& at) {
+  return points[at.low] + at.fraction * (points[at.high] - points[at.low]);
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> crossing_points(std::vector<Eigen::Vector3d> points,
+                                             std::span<const EdgeCrossing> crossings) {
+  const std::size_t count = points.size();
+  points.reserve(count + crossings.size());
+  for (const EdgeCrossing& at : crossings) points.push_back(on_edge(std::span(points).first(count), at));
+  return points;
+}
+
 std::optional<PlaneCut> cut_by_plane(const TriangleSurface& surface, int axis, double offset) {
   PlaneCut cut;
   cut.points = surface.points;
@@ -55,8 +71,8 @@ std::optional<PlaneCut> cut_by_plane(const TriangleSurface& surface, int axis, d
     const auto [it, added] = crossing_of.try_emplace(detail::make_edge(a, b), static_cast<int>(cut.points.size()));
     if (added) {
       const int low = it->first.first, high = it->first.second;  // the same point from either triangle
-      const double s = height[low] / (height[low] - height[high]);
-      cut.points.push_back(cut.points[low] + s * (cut.points[high] - cut.points[low]));
+      cut.crossings.push_back({low, high, height[low] / (height[low] - height[high])});
+      cut.points.push_back(on_edge(cut.points, cut.crossings.back()));
     }
     return it->second;
   };

@@ -140,7 +140,9 @@ struct MoveOptions {
 // surfaces have the triangulations they were inserted (or last moved) with, in the same order, and only
 // their points moved.
 //   1. Each S_M node keeps its parameters u in P and goes to φ(u), φ the previous step's parameterization
-//      over the moved surface (the parameters of S's vertices kept, their positions new).
+//      over the moved surface (the parameters of S's vertices kept, their positions new). A closed
+//      surface's two halves are cut from it along the same edges at the same fractions as at its
+//      insertion (projection_target), so each half keeps its parametric triangles too.
 //   2. The nodes within move.drag_rings edge rings of S_M follow: a node moves by 1 - r / R times the
 //      mean displacement of its neighbours in the rings before, r its distance from S_M along the mesh's
 //      edges and R that of the nearest node of the next ring, along the axes the box leaves it. The tets beside the interface keep their shape instead of being
@@ -151,7 +153,9 @@ struct MoveOptions {
 // The topology, refinement, tags and V_M are the previous step's; nodes beyond the rings (and SUS's band,
 // when it runs) keep their positions bit for bit. No retry: an interface that moved too far for SUS throws
 // MeshingError, and the caller inserts the surfaces anew (stages/sequence.hpp). Throws InputError if a
-// surface's triangulation differs (a parametric triangle of the moved surface flipped or flat).
+// surface's triangulation differs (a parametric triangle of the moved surface flipped or flat). A surface
+// clipped by the box (surface/box_clipping.hpp) is given clipped, each step: it keeps its triangulation
+// while no vertex of S crosses a box plane, and its S_M's rim nodes on the box stay on their planes.
 InsertionResult move_surfaces(const InsertionResult& previous, std::span<const TriangleSurface> surfaces,
                               const InsertionOptions& options, const MoveOptions& move = {});
 

@@ -29,7 +29,8 @@
 //          usually does); of the planes that leave both S_M and S in two disks without chords (interior
 //          edges between two rim vertices), the one nearest to the middle of S_M is taken. Both halves take
 //          the same corners on the cut and space the nodes between them alike, so a node on the cut lands
-//          on the same point of S from either half. The rim gap is not measured: there is no rim.
+//          on the same point of S from either half. The rim gap is not measured: there is no rim. Each
+//          half keeps how it was cut from S (projection_target), so that a moved S is cut alike.
 // Output   the moved mesh (tets may be tangled: step 4 untangles them), the parameterizations, and
 //          statistics: how far nodes moved, how far they are from S afterwards, inverted tets.
 // Errors   UncoveredSurfaceError (a MeshingError) if the rim gap exceeds options.max_rim_gap (the message
@@ -43,6 +44,7 @@
 #include <meccano/mesh/tet_mesh.hpp>
 #include <meccano/stages/parameterization.hpp>
 #include <meccano/stages/volumetric_approximation.hpp>
+#include <meccano/surface/closed_surface.hpp>
 #include <meccano/surface/creases.hpp>
 #include <meccano/surface/triangle_surface.hpp>
 
@@ -102,6 +104,10 @@ struct SurfaceProjection {
   int orientation = 1;                         // the sign of their areas in P (uv), which step 4 keeps
   CreaseNodes creases;                         // which nodes lie on a crease line of S, and where
   ProjectionStats stats;
+  // For one half of a closed S (empty for a disk): the half's triangles over S's points and the cut's
+  // crossings, which lie on S's edges as `cut_crossings` say, before its rim chords were split.
+  std::vector<EdgeCrossing> cut_crossings;
+  std::vector<std::array<int, 3>> cut_triangles;
 };
 
 // Whether S_M's triangle (indices of `projection.nodes`) keeps S_M's orientation in P with its node `moved`
@@ -120,5 +126,15 @@ SurfaceProjection project_onto_surface(TetMesh& mesh, const TetRegion& volumetri
 std::vector<SurfaceProjection> project_closed_onto_surface(TetMesh& mesh, const TetRegion& volumetric, int index,
                                                            const TriangleSurface& surface, const TriangleBVH& tree,
                                                            const ProjectionOptions& options = {});
+
+// Every S_M node of `projection` moves to φ of its parameters; a rim node on the box keeps its coordinates
+// on its box planes exactly (S's rim lies on them). Sets the statistics' node count, largest move and
+// largest distance to S (`tree`) afterwards.
+void move_nodes_onto_surface(TetMesh& mesh, SurfaceProjection& projection, const TriangleBVH& tree);
+
+// The disk `projection` maps S_M onto, made from `surface`: S at its current points, triangulated as when
+// the projection was made. S with its rim chords split, or for a half of a closed S that half, cut along
+// the same edges of S at the same fractions (so a moved surface gives the same parametric triangles).
+TriangleSurface projection_target(const SurfaceProjection& projection, const TriangleSurface& surface);
 
 }  // namespace meccano

@@ -13,8 +13,8 @@
 //          splits) it can tangle them and then costs as much as an insertion, hence second.
 //          Away from the interface the mesh stays the previous step's, node for node. The step inserts
 //          the surfaces anew instead, from the meccano mesh, when
-//            - a triangulation changed,
-//            - a surface is closed (move_surfaces does not move closed surfaces yet),
+//            - a triangulation changed (a surface clipped by the box, given clipped, changes its triangulation
+//              when one of its vertices crosses a box plane),
 //            - a vertex of a surface moved farther than `max_move_in_resolutions` times the l_r it was
 //              inserted at since the previous step (then it left the refinement made around it, and a
 //              move is not tried: at 1.3 l_r per step every move of the cube example lost quality and

@@ -13,7 +13,10 @@
 //        vertices exactly. A triangle across the plane becomes a triangle on one side and one or two on
 //        the other. Where the plane passes within cut_snap of an edge's span along the axis from a vertex
 //        of that edge, the vertex counts as on the plane instead (a crossing there would leave a sliver):
-//        the cut then runs through it, a little off the plane, and no point of S moves.
+//        the cut then runs through it, a little off the plane, and no point of S moves. Each crossing is
+//        recorded as a fraction of its edge of S: crossing_points places the crossings on S's edges again
+//        after S's points moved (same triangulation), so that a moving closed surface is cut alike at every
+//        step (the parts then keep their triangles; the crossings no longer lie on one plane).
 //        triangulate_star_shaped: a closed surface for tests and demos (spheres, ellipsoids, blobs): the
 //        octahedron |x| + |y| + |z| = 1 with each face cut into n^2 triangles, every point p placed at
 //        place(p / |p|), normals pointing out when `place` keeps the directions' order (a star-shaped image).
@@ -27,6 +30,7 @@
 #include <array>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -40,12 +44,23 @@ TriangleSurface oriented_outward(TriangleSurface surface);
 
 inline constexpr double cut_snap = 1e-3;
 
+// The point low + fraction (high - low) on the edge (low, high) of S.
+struct EdgeCrossing {
+  int low = 0, high = 0;
+  double fraction = 0.0;
+};
+
 struct PlaneCut {
   std::vector<Eigen::Vector3d> points;  // S's points, then the crossings
+  std::vector<EdgeCrossing> crossings;  // where each crossing lies on S (same order)
   std::vector<std::array<int, 3>> below, above;
 };
 
 std::optional<PlaneCut> cut_by_plane(const TriangleSurface& surface, int axis, double offset);
+
+// `points` (S's, wherever they are now), then the `crossings` on S's edges between them.
+std::vector<Eigen::Vector3d> crossing_points(std::vector<Eigen::Vector3d> points,
+                                             std::span<const EdgeCrossing> crossings);
 
 TriangleSurface triangulate_star_shaped(const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& place, int n,
                                         std::string name);

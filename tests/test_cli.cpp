@@ -421,6 +421,33 @@ TEST_F(CliTest, SequenceWritesEveryStepWithItsPreviousNodesAndAReport) {
   }
 }
 
+// A growing inclusion (closed) and a fault through the box top (clipped by the tool at each step) moving
+// along the top: both are moved, not inserted anew, and every step's file passes check.
+TEST_F(CliTest, SequenceMovesAClosedSurfaceAndOneClippedByTheBox) {
+  constexpr double resolution = 0.0625;
+  std::string steps;
+  for (int k = 0; k < 3; ++k) {
+    const double radius = 0.2 + k * resolution / 4;
+    const TriangleSurface inclusion = testing::ellipsoid({0.3, 0.5, 0.45}, {radius, radius, radius}, 8);
+    TriangleSurface fault = testing::graph_patch([](double, double z) { return 0.72 + 0.05 * z; },
+                                                 {0.2 + k * resolution / 4, 0.8 + k * resolution / 4}, {0.3, 1.2}, 12);
+    for (Eigen::Vector3d& p : fault.points) p = Eigen::Vector3d(p.z(), p.x(), p.y());  // (y, z, x) -> (x, y, z)
+    steps += " --step " + write_obj("inclusion_" + std::to_string(k) + ".obj", inclusion) + ":inclusion," +
+             write_obj("fault_" + std::to_string(k) + ".obj", fault) + ":fault";
+  }
+  const CliRun run = run_cli("sequence --box 0,0,0,1,1,1 --level 3 --resolution " + std::to_string(resolution) + steps +
+                             " --output " + path("both_{step}.msh"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  for (const char* line : {"step 0: inserted", "step 1: moved", "step 2: moved"})
+    EXPECT_NE(run.output.find(line), std::string::npos) << line << "\n" << run.output;
+  for (int k = 0; k < 3; ++k) {
+    const CliRun check = run_cli("check " + path("both_" + std::to_string(k) + ".msh"));
+    EXPECT_EQ(check.status, 0) << check.output;
+    for (const char* group : {"interface_inclusion: ok", "inside_inclusion: ok", "interface_fault: ok"})
+      EXPECT_NE(check.output.find(group), std::string::npos) << group << "\n" << check.output;
+  }
+}
+
 TEST_F(CliTest, SequenceRefusesWhatItCannotDoAndWritesNothing) {
   const std::string patch = write_obj("patch.obj", testing::paper_like_patch(10));
   const std::string start = "sequence --box 0,0,0,1,1,1 --level 3 --resolution 0.0625 ";

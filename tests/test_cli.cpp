@@ -427,7 +427,7 @@ TEST_F(CliTest, SequenceMovesAClosedSurfaceAndOneClippedByTheBox) {
   constexpr double resolution = 0.0625;
   std::string steps;
   for (int k = 0; k < 3; ++k) {
-    const double radius = 0.2 + k * resolution / 4;
+    const double radius = 0.2 + k * 0.003;  // its area grows by less than --max-area-change's 10 %
     const TriangleSurface inclusion = testing::ellipsoid({0.3, 0.5, 0.45}, {radius, radius, radius}, 8);
     TriangleSurface fault = testing::graph_patch([](double, double z) { return 0.72 + 0.05 * z; },
                                                  {0.2 + k * resolution / 4, 0.8 + k * resolution / 4}, {0.3, 1.2}, 12);

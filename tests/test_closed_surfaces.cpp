@@ -274,25 +274,28 @@ TEST(ClosedSurface, MovingOneCutsItAlikeAndLandsOnTheMovedSurface) {
   }
 }
 
-// A growing sphere, a quarter of l_r per step: the steps are moved, not inserted anew, and each is a valid
-// inclusion whose nodes away from it keep their places.
-TEST(ClosedSurface, ASequenceMovesAGrowingSphere) {
+// A growing sphere: its steps are moved, not inserted anew, and each is a valid inclusion whose nodes away
+// from it keep their places, until its area has grown by more than a tenth since its insertion (then the
+// refinement made for it is stretched: the step is inserted anew).
+TEST(ClosedSurface, ASequenceMovesAGrowingSphereUntilItsAreaChanged) {
   InsertionOptions options;
   options.resolution = 0.1;
   SurfaceSequence sequence(make_cube_meccano(kUnitBox, 0), options);
   const TriangleSurface sphere = testing::sphere(8);  // radius 0.3
-  int moved = 0;
-  for (int step = 0; step < 4; ++step) {
-    const TriangleSurface surface = grown(sphere, 1.0 + step * 0.025 / 0.3);
+  for (int step = 0; step < 5; ++step) {
+    // Radius 0.3 + 0.004 step: the area grows by 2.7, 5.4, 8.2 and 10.9 % at steps 1-4.
+    const TriangleSurface surface = grown(sphere, 1.0 + step * 0.004 / 0.3);
     const SequenceStep& done = sequence.advance({surface});
     SCOPED_TRACE("step " + std::to_string(step) + ": " + done.inserted_because);
-    moved += done.kind == StepKind::moved;
+    EXPECT_EQ(done.kind, step == 0 || step == 4 ? StepKind::inserted : StepKind::moved);
     expect_closed_interface(done.result, surface, 0, 0.05);
     if (step > 0) {
       EXPECT_GT(done.nodes_unchanged, 0);
     }
+    if (step == 4) {
+      EXPECT_THAT(done.inserted_because, HasSubstr("the area of sphere changed by 10.9"));
+    }
   }
-  EXPECT_GE(moved, 2);
 }
 
 }  // namespace

@@ -158,9 +158,12 @@ min/mean/std, inverted, min_dihedral_deg, max_dihedral_deg, and the step's whole
 `insertion`) and the total `seconds`. A step whose surfaces keep their triangulations is made from the
 previous step's mesh: its interface moves onto them and the rings of nodes around it follow (mode
 "moved"); it is inserted into the meccano mesh anew (mode "inserted", with `inserted_because`) when a
-triangulation changed (a surface clipped by the box changes it when a vertex crosses a box plane), when a vertex moved farther than --max-move l_r (default 1), or when the moved
-mesh stays tangled or its worst tet falls more than --max-quality-loss (default 0.02, either mean ratio)
-below what the insertions gave. --from-scratch inserts every step anew.
+triangulation changed (a surface clipped by the box changes it when a vertex crosses a box plane), when
+a vertex moved farther than --max-move l_r (default 1), when a surface's area differs from its area at
+the last insertion by more than --max-area-change of it (default 0.1: a growing surface stretches the
+refinement made for it), or when the moved mesh stays tangled or its worst tet falls more than
+--max-quality-loss (default 0.02, either mean ratio) below what the insertions gave. --from-scratch
+inserts every step anew.
 
 check FILE.msh checks the invariants of a tet mesh of a box in any Gmsh MSH file (2.2 or 4.1, ASCII or
 binary; this tool's, Gmsh's, ...): conformity, orientation, volume, the box sides xmin ... zmax (if the
@@ -607,6 +610,9 @@ SequenceOptions parse_sequence_options(const std::vector<std::string>& args) {
   });
   parser.value({"--max-move"}, [&](const std::string& text) {
     parsed.sequence.max_move_in_resolutions = meccano::tools::parse_non_negative("--max-move", text);
+  });
+  parser.value({"--max-area-change"}, [&](const std::string& text) {
+    parsed.sequence.max_area_change = meccano::tools::parse_non_negative("--max-area-change", text);
   });
   declare_method_options(parser, options);
   declare_output_options(parser, options, output_format, msh_version_unused);

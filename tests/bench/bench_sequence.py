@@ -140,10 +140,13 @@ def run_hxt(build, cli, surface, box, resolution, mesh, work, name):
     split_surface = split.stdout.split()[0]
     numbers = [float(v) for v in box.split(",")]
     report = os.path.join(work, f"{name}.hxt.json")
-    subprocess.run([os.path.join(build, "reference", "reference-gmsh"), "--box", box, "--algorithm", "hxt",
-                    "--threads", "2", "--surface", split_surface + ":surface", "--size", repr(far_size(numbers)),
-                    "--size-near-surface", repr(h_s), "--size-distance", repr(4 * resolution), "--quiet",
-                    "--output", os.path.join(work, f"{name}.hxt.msh"), "--report", report], check=True)
+    run = subprocess.run([os.path.join(build, "reference", "reference-gmsh"), "--box", box, "--algorithm", "hxt",
+                          "--threads", "2", "--surface", split_surface + ":surface", "--size", repr(far_size(numbers)),
+                          "--size-near-surface", repr(h_s), "--size-distance", repr(4 * resolution), "--quiet",
+                          "--output", os.path.join(work, f"{name}.hxt.msh"), "--report", report],
+                         capture_output=True, text=True)
+    if run.returncode != 0:  # recorded in the table, the other runs go on
+        return {"failed": (run.stderr.strip().splitlines() or [f"exit status {run.returncode}"])[-1]}
     with open(report) as f:
         return json.load(f)
 
@@ -160,8 +163,12 @@ def case_table(name, moving, scratch, hxt):
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for m, s in zip(moving, scratch):
         h = hxt.get(m["step"])
-        hxt_cells = (f"{h['seconds']['total']:.2f} ({h['tets']:,})", f"{h['seconds']['total'] / m['seconds']:.1f}") \
-            if h else ("", "")
+        if h is None:
+            hxt_cells = ("", "")
+        elif "failed" in h:
+            hxt_cells = (f"failed: {h['failed']}", "")
+        else:
+            hxt_cells = (f"{h['seconds']['total']:.2f} ({h['tets']:,})", f"{h['seconds']['total'] / m['seconds']:.1f}")
         print(f"| {m['step']} | {m['mode']} | {m['seconds']:.2f} / {s['seconds']:.2f} | "
               f"{s['seconds'] / m['seconds']:.1f}× | {m['tets']:,} / {s['tets']:,} | "
               f"{percent(m['nodes_unchanged'], m['nodes'])} / {percent(s['nodes_unchanged'], s['nodes'])} | "
@@ -181,7 +188,7 @@ def summary_row(name, moving, scratch, hxt):
                for m, s in later)
     unchanged = f'{100 * min(m["nodes_unchanged"] / m["nodes"] for m, _ in moved):.1f} %' if moved else "–"
     hxt_ratio = [hxt[m["step"]]["seconds"]["total"] / m["seconds"] for m in moving[1:]
-                 if m["step"] in hxt and m["mode"] == "moved"]
+                 if "seconds" in hxt.get(m["step"], {}) and m["mode"] == "moved"]
     print(f"| {name} | {len(moved)} of {len(later)} | {median} | {total:.1f}× | "
           f"{', '.join(f'{r:.1f}×' for r in hxt_ratio) or '–'} | {unchanged} | "
           f"{moving[-1]['tets'] / scratch[-1]['tets']:.3f} | {loss:+.3f} |")

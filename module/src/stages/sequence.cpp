@@ -42,6 +42,13 @@ std::string SurfaceSequence::why_not_moved(const std::vector<TriangleSurface>& s
           << sequence_.max_move_in_resolutions;
       return why.str();
     }
+    const double change = surface_area(surfaces[s]) / inserted_areas_[s] - 1.0;
+    if (std::abs(change) > sequence_.max_area_change) {
+      std::ostringstream why;
+      why << "the area of " << surfaces[s].name << " changed by " << 100 * change
+          << " % since it was inserted, more than " << 100 * sequence_.max_area_change << " %";
+      return why.str();
+    }
   }
   return {};
 }
@@ -85,6 +92,8 @@ const SequenceStep& SurfaceSequence::advance(std::vector<TriangleSurface> surfac
     if (!last_) inserted_quality_.meccano.min = inserted_quality_.equilateral.min = cap;
     inserted_quality_.meccano.min = std::min(inserted_quality_.meccano.min, quality.meccano.min);
     inserted_quality_.equilateral.min = std::min(inserted_quality_.equilateral.min, quality.equilateral.min);
+    inserted_areas_.clear();
+    for (const TriangleSurface& surface : surfaces) inserted_areas_.push_back(surface_area(surface));
   }
   if (last_) {
     step.previous_node = match_previous_nodes(last_->result.mesh, step.result.mesh);

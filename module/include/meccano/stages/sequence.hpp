@@ -19,6 +19,10 @@
 //              inserted at since the previous step (then it left the refinement made around it, and a
 //              move is not tried: at 1.3 l_r per step every move of the cube example lost quality and
 //              cost an insertion's time in vain, design.md "A moving interface"),
+//            - a surface's area differs from its area at the last insertion by more than
+//              `max_area_change` of it (a growing or shrinking surface stretches or squeezes the refinement
+//              made for it: a sphere moved while it grew by 5 l_r kept 0.63 of the tets an insertion
+//              gives it, its interface edges longer than the l_r asked for),
 //            - the moved interface stays tangled after SUS (it moved too far for the tets beside it), or
 //            - its worst tet, by either mean ratio, falls more than `max_quality_loss` below the worst of
 //              the steps inserted anew so far, or below the improvement's threshold if that is lower
@@ -46,6 +50,7 @@ struct SequenceOptions {
   bool always_insert = false;            // insert every step anew (a baseline for comparisons)
   double max_quality_loss = 0.02;        // in either mean ratio's minimum, against the steps inserted anew
   double max_move_in_resolutions = 1.0;  // a step that moves a surface's vertex farther is inserted anew
+  double max_area_change = 0.1;          // as a share of a surface's area at the last insertion
   // The ways a step is moved, tried in turn before it is inserted anew: the cheap one first.
   std::vector<MoveOptions> moves{{.drag_rings = 6, .smooth = false}, {.drag_rings = 2, .smooth = true}};
 };
@@ -80,6 +85,7 @@ class SurfaceSequence {
   std::optional<SequenceStep> last_;
   std::vector<TriangleSurface> surfaces_;  // the last step's
   QualitySummary inserted_quality_;        // the worst of the steps inserted anew, capped by the threshold
+  std::vector<double> inserted_areas_;     // the surfaces' areas at the last step inserted anew
 };
 
 }  // namespace meccano

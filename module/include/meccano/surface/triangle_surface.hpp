@@ -18,4 +18,7 @@ struct TriangleSurface {
   std::vector<std::array<int, 3>> triangles;
 };
 
+// The sum of the triangles' areas.
+double surface_area(const TriangleSurface& surface);
+
 }  // namespace meccano

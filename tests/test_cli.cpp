@@ -463,6 +463,8 @@ TEST_F(CliTest, SequenceRefusesWhatItCannotDoAndWritesNothing) {
        "--max-move must not be negative"},
       {start + "--step " + patch + " --max-quality-loss x --output " + path("a_{step}.msh"),
        "--max-quality-loss: 'x' is not a finite number"},
+      {start + "--step " + patch + " --max-area-change -0.1 --output " + path("a_{step}.msh"),
+       "--max-area-change must not be negative"},
   };
   for (const auto& [arguments, message] : usage) {
     const CliRun run = run_cli(arguments);

@@ -367,7 +367,8 @@ def equal_tets_row(case, divisor, module, hxt_runs):
 def equal_resolution_row(case, divisor, module, field):
     head = [case, resolution_label(divisor, module), f"{module['seconds']:.2f}"]
     if field is None:
-        return head + ["not run (no measure of the module's interface)", "", "", "", "", "", ""]
+        reason = "not run" if module["measure"] else "not run (no measure of the module's interface)"
+        return head + [reason, "", "", "", "", "", ""]
     if not field["ok"]:
         return head + [field["label"], "**FAILED**", "", "", "", "", ""]
     return head + [field["label"], thousands(field["tets"]), f"{field['seconds']:.2f}",

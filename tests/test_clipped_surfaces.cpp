@@ -65,11 +65,6 @@ double area(const std::vector<Eigen::Vector3d>& points, const std::vector<std::a
   return sum;
 }
 
-double area(const TriangleSurface& surface) {
-  std::vector<std::array<VertexId, 3>> triangles(surface.triangles.begin(), surface.triangles.end());
-  return area(surface.points, triangles);
-}
-
 // Every invariant of a clipped interface, for the only surface of `result`. `area_tolerance`: the share
 // of S's area the interface's flat faces may differ by (0 up to round-off for a plane).
 void expect_clipped_interface(const InsertionResult& result, const TriangleSurface& surface,
@@ -124,7 +119,7 @@ void expect_clipped_interface(const InsertionResult& result, const TriangleSurfa
     rim_nodes_on_box += box_sides(mesh.points[v], mesh.meccano.box) != 0;
   }
   EXPECT_GT(rim_nodes_on_box, 0);
-  EXPECT_NEAR(area(mesh.points, triangles), area(surface), area_tolerance * area(surface) + tolerance);
+  EXPECT_NEAR(area(mesh.points, triangles), surface_area(surface), area_tolerance * surface_area(surface) + tolerance);
 
   // Quality of the order the disks of the tests get.
   EXPECT_GT(result.quality_after_smoothing.equilateral.min, 0.1);
@@ -149,7 +144,7 @@ TEST(ClippedSurface, ObliquePlanes) {
   const TriangleSurface oblique = clipped(
       testing::graph_patch([](double x, double y) { return 0.3 + 0.35 * x + 0.1 * y; }, {-0.3, 1.3}, {-0.3, 1.3}, 16),
       kUnitBox);
-  EXPECT_NEAR(area(oblique), std::sqrt(1.0 + 0.35 * 0.35 + 0.1 * 0.1), 1e-12);
+  EXPECT_NEAR(surface_area(oblique), std::sqrt(1.0 + 0.35 * 0.35 + 0.1 * 0.1), 1e-12);
   const InsertionResult result = insert(oblique, kUnitBox, 0.08);
   expect_clipped_interface(result, oblique);
   // The plane divides the box: below it (its negative side) lies the volume of 0.3 + 0.35 x + 0.1 y.
@@ -167,7 +162,7 @@ TEST(ClippedSurface, ObliquePlanes) {
 
   const TriangleSurface corner = clipped(
       testing::graph_patch([](double x, double y) { return 0.6 - x - y; }, {-0.3, 0.9}, {-0.3, 0.9}, 16), kUnitBox);
-  EXPECT_NEAR(area(corner), std::sqrt(3.0) / 4.0 * 0.72, 1e-12);
+  EXPECT_NEAR(surface_area(corner), std::sqrt(3.0) / 4.0 * 0.72, 1e-12);
   expect_clipped_interface(insert(corner, kUnitBox, 0.06), corner);
 }
 

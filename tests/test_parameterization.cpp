@@ -633,13 +633,6 @@ TEST(Parameterization, CornersMustBeRimVerticesInCyclicOrder) {
 // ---------------------------------------------------------------------------------------------------
 // Rim chords (surface/rim_chords.hpp): interior edges joining two rim vertices.
 
-double total_area(const TriangleSurface& surface) {
-  double area = 0.0;
-  for (const auto& [a, b, c] : surface.triangles)
-    area += 0.5 * (surface.points[b] - surface.points[a]).cross(surface.points[c] - surface.points[a]).norm();
-  return area;
-}
-
 TEST(RimChords, ASawtoothRimMapsOneToOneOnceItsChordsAreSplit) {
   // Each tooth's base is a chord with the tooth's apex alone on its short arc: a corner must sit on every
   // apex, and eight teeth need more than four corners.
@@ -654,7 +647,7 @@ TEST(RimChords, ASawtoothRimMapsOneToOneOnceItsChordsAreSplit) {
   for (std::size_t i = 0; i < patch.points.size(); ++i) EXPECT_EQ(split.points[i], patch.points[i]) << "point " << i;
   EXPECT_NO_THROW(require_surface_topology(split));
   EXPECT_EQ(rim_loop(split), rim_loop(patch));
-  EXPECT_NEAR(total_area(split), total_area(patch), 1e-14);
+  EXPECT_NEAR(surface_area(split), surface_area(patch), 1e-14);
   // Each new point is the midpoint of a chord, so it lies on the patch: the geometry did not change.
   const TriangleBVH tree(patch);
   for (std::size_t i = patch.points.size(); i < split.points.size(); ++i)

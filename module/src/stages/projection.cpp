@@ -118,7 +118,6 @@ void take_parameters(SurfaceProjection& result, std::span<const std::array<int, 
   }
 }
 
-
 // One disk of S_M (`triangles`, over the mesh's numbering, oriented like S) onto one disk of S (`target`,
 // parameterized), with S_M's corners and anchors given: steps 1-3 once the corners are chosen. `pulled`
 // holds S_M's nodes pulled towards S.

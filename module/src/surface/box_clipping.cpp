@@ -96,13 +96,6 @@ std::vector<int> triangle_components(std::span<const std::array<int, 3>> triangl
   return component;
 }
 
-double area(const TriangleSurface& surface) {
-  double sum = 0.0;
-  for (const auto& t : surface.triangles)
-    sum += (surface.points[t[1]] - surface.points[t[0]]).cross(surface.points[t[2]] - surface.points[t[0]]).norm();
-  return 0.5 * sum;
-}
-
 }  // namespace
 
 std::vector<TriangleSurface> clip_to_box(const TriangleSurface& surface, const Box& box) {
@@ -126,7 +119,7 @@ std::vector<TriangleSurface> clip_to_box(const TriangleSurface& surface, const B
   for (std::size_t t = 0; t < inside.triangles.size(); ++t) triangles[component[t]].push_back(inside.triangles[t]);
   std::vector<TriangleSurface> parts;
   for (const auto& part : triangles) parts.push_back(compacted(inside, part));
-  std::ranges::stable_sort(parts, std::greater<>(), [](const TriangleSurface& part) { return area(part); });
+  std::ranges::stable_sort(parts, std::greater<>(), [](const TriangleSurface& part) { return surface_area(part); });
   for (std::size_t k = 0; k < parts.size(); ++k) {
     if (parts.size() > 1) parts[k].name = surface.name + "_" + std::to_string(k + 1);
     try {

@@ -307,5 +307,28 @@ TEST(Bisection, ChildCallbackReportsEveryNewTet) {
   EXPECT_EQ(parent_of.size(), mesh.tets.size());
 }
 
+// Every local face of every tet appears once, keyed by its sorted vertices, in key order, so that a face's
+// tets are neighbours in the list (checked on a locally refined mesh, whose vertices have up to dozens of faces).
+TEST(TetMesh, SortedFaceRecordsListEveryLocalFaceOnceInKeyOrder) {
+  std::mt19937 rng(7);
+  TetMesh mesh = make_cube_meccano(test_boxes[3], 1);
+  refine_randomly(mesh, rng, 40, 25);
+  const std::vector<FaceRecord> faces = sorted_face_records(mesh.tets);
+  ASSERT_EQ(faces.size(), 4 * mesh.tets.size());
+  std::vector<int> seen(faces.size(), 0);
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const FaceRecord& face = faces[i];
+    std::array<VertexId, 3> key{};
+    for (int k = 0; k < 3; ++k) key[k] = mesh.tets[face.tet][face_vertices[face.local_face][k]];
+    std::sort(key.begin(), key.end());
+    EXPECT_EQ(face.key, key) << "record " << i;
+    ++seen[4 * static_cast<std::size_t>(face.tet) + face.local_face];
+    if (i > 0) {
+      EXPECT_LE(faces[i - 1].key, face.key) << "record " << i;
+    }
+  }
+  EXPECT_EQ(std::ranges::count(seen, 1), std::ssize(seen));
+}
+
 }  // namespace
 }  // namespace meccano

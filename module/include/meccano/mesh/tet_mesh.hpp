@@ -138,7 +138,8 @@ struct TetMesh {
 int grid_orientation(const TetMesh& mesh, TetId t);
 
 // Every local face of every tet, keyed by its sorted vertices and sorted by key, so that the tets sharing
-// a face are adjacent in the list. Takes the tets alone so that a mesh read from a file can be checked too.
+// a face are adjacent in the list. Takes the tets alone so that a mesh read from a file can be checked too;
+// their vertex ids must not be negative (the list is bucketed by vertex).
 struct FaceRecord {
   std::array<VertexId, 3> key;
   TetId tet;

@@ -149,6 +149,8 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
        "--threads must be at least 1"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --fallback-sweeps -1 --output " + path("a.msh"),
        "--fallback-sweeps must not be negative"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --drag-rings -1 --output " + path("a.msh"),
+       "--drag-rings must not be negative"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --finer-retries -2 --output " + path("a.msh"),
        "--finer-retries must not be negative"},
       {"--box 0,0,0,1,1,1 --histograms h.csv --output " + path("a.msh"), "need at least one --surface"},
@@ -730,6 +732,25 @@ TEST_F(CliTest, UnwritableOutputFailsWithStatusOne) {
   const CliRun run = run_cli("--box 0,0,0,1,1,1 --level 1 --output /nonexistent-dir/out.msh");
   EXPECT_EQ(run.status, 1) << run.output;
   EXPECT_NE(run.output.find("cannot write /nonexistent-dir/out.msh"), std::string::npos) << run.output;
+}
+
+// --drag-rings N: the nodes near S_M follow it before SUS, which the progress and the report say; without
+// it the report has no "drag".
+TEST_F(CliTest, DragRingsAreReportedWhenAsked) {
+  const std::string file = write_obj("patch.obj", testing::paper_like_patch(12));
+  const std::string meshing = "--box 0,0,0,1,1,1 --surface " + file + " --resolution 0.07 --output " + path("mesh.msh");
+  const CliRun dragged = run_cli(meshing + " --drag-rings 3 --report " + path("dragged.json"));
+  ASSERT_EQ(dragged.status, 0) << dragged.output;
+  EXPECT_NE(dragged.output.find(" rings of the interfaces follow them; "), std::string::npos) << dragged.output;
+  std::ifstream dragged_file(path("dragged.json"));
+  const std::string report((std::istreambuf_iterator<char>(dragged_file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(report.find("\"drag\": {\n    \"rings\": 3,\n    \"nodes\": "), std::string::npos) << report;
+
+  const CliRun still = run_cli(meshing + " --quiet --report " + path("still.json"));
+  ASSERT_EQ(still.status, 0) << still.output;
+  std::ifstream still_file(path("still.json"));
+  const std::string plain((std::istreambuf_iterator<char>(still_file)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(plain.find("\"drag\""), std::string::npos) << plain;
 }
 
 // Every path a run writes is checked before any work: one that cannot be written fails at once, naming

@@ -226,17 +226,8 @@ TEST(Smoothing, GivesTheSameMeshWithOneAndTwoThreads) {
   EXPECT_EQ(one.smoothing.sweeps.size(), two.smoothing.sweeps.size());
 }
 
-// In band mode only nodes within the band's rings of S_M move; the mesh is still untangled.
-TEST(Smoothing, BandModeMovesOnlyNodesNearTheSurface) {
-  const TriangleSurface surface = testing::spherical_cap(16);
-  const Box box{{0, 0, 0}, {1, 1, 1}};
-  InsertionOptions options;
-  options.resolution = 1.0 / 24;
-  options.last_stage = Stage::projection;
-  InsertionResult result = insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
-  const std::vector<Eigen::Vector3d> projected = result.mesh.points;
-
-  // Edge rings from S_M, found independently of the smoother.
+// Each node's edge ring from S_M's nodes (0 on S_M, -1 if unreached), found independently of the pipeline.
+std::vector<int> edge_rings_from_interface(const InsertionResult& result) {
   std::vector<int> ring(result.mesh.points.size(), -1);
   std::vector<VertexId> front = result.surfaces[0].projections.front().nodes;
   for (VertexId v : front) ring[v] = 0;
@@ -252,6 +243,19 @@ TEST(Smoothing, BandModeMovesOnlyNodesNearTheSurface) {
           }
     front = std::move(next);
   }
+  return ring;
+}
+
+// In band mode only nodes within the band's rings of S_M move; the mesh is still untangled.
+TEST(Smoothing, BandModeMovesOnlyNodesNearTheSurface) {
+  const TriangleSurface surface = testing::spherical_cap(16);
+  const Box box{{0, 0, 0}, {1, 1, 1}};
+  InsertionOptions options;
+  options.resolution = 1.0 / 24;
+  options.last_stage = Stage::projection;
+  InsertionResult result = insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
+  const std::vector<Eigen::Vector3d> projected = result.mesh.points;
+  const std::vector<int> ring = edge_rings_from_interface(result);
 
   SmoothingOptions band{.mode = SmoothingMode::band, .band_rings = 2};
   std::vector<SurfaceProjection*> projections{&result.surfaces[0].projections.front()};
@@ -264,6 +268,48 @@ TEST(Smoothing, BandModeMovesOnlyNodesNearTheSurface) {
     else moved_in_band += result.mesh.points[v] != projected[v];
   }
   EXPECT_GT(moved_in_band, 0);
+}
+
+// With drag_rings, the nodes within that many rings of S_M follow it after the projection (and in a band
+// no farther than the band): S_M's nodes land where they did without, fewer tets are inverted, box nodes
+// stay on the box, nothing beyond the rings moves, and SUS then untangles the mesh as before.
+TEST(Smoothing, NodesNearTheInterfaceFollowItWithDragRings) {
+  const TriangleSurface surface = testing::spherical_cap(16);
+  const Box box{{0, 0, 0}, {1, 1, 1}};
+  InsertionOptions options;
+  options.resolution = 1.0 / 24;
+  options.last_stage = Stage::projection;
+  const InsertionResult still = insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
+  const std::vector<int> ring = edge_rings_from_interface(still);
+  const std::int64_t inverted_without = still.surfaces[0].projection_stats().inverted_tets;
+  ASSERT_GT(inverted_without, 0);
+  EXPECT_EQ(still.drag.rings, 0);
+
+  for (const SmoothingMode mode : {SmoothingMode::whole_mesh, SmoothingMode::band}) {
+    SCOPED_TRACE(mode == SmoothingMode::whole_mesh ? "whole" : "band");
+    options.drag_rings = 4;
+    options.smoothing.mode = mode;
+    options.smoothing.band_rings = 2;
+    options.last_stage = Stage::projection;
+    const InsertionResult dragged = insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
+    const int rings = mode == SmoothingMode::whole_mesh ? 4 : 2;
+    EXPECT_EQ(dragged.drag.rings, rings);
+    EXPECT_LT(dragged.drag.inverted_tets, inverted_without / 2);
+    EXPECT_TRUE(verify_mesh(dragged.mesh, {.physical = false}).ok());
+    std::int64_t followed = 0;
+    for (VertexId v = 0; v < still.mesh.num_vertices(); ++v) {
+      if (ring[v] == 0 || ring[v] > rings)
+        ASSERT_EQ(dragged.mesh.points[v], still.mesh.points[v]) << "node " << v << " in ring " << ring[v];
+      else followed += dragged.mesh.points[v] != still.mesh.points[v];
+    }
+    EXPECT_EQ(followed, dragged.drag.nodes);
+    EXPECT_GT(followed, 0);
+
+    options.last_stage = Stage::smoothing;
+    const InsertionResult smoothed = insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
+    EXPECT_TRUE(smoothed.smoothing.untangled());
+    EXPECT_TRUE(verify_mesh(smoothed.mesh, {.physical = true}).ok());
+  }
 }
 
 // On this disk (surface s1 of stress case 87, seed 1) untangling towards the meccano target stalls at one

@@ -147,6 +147,10 @@ void write_insertion_report(JsonWriter& json, const InsertionResult& result, Sta
   json.key("surfaces").begin_array();
   for (const SurfaceInsertion& inserted : result.surfaces) write_surface(json, inserted, last_stage);
   json.end_array();
+  if (last_stage >= Stage::projection && result.drag.rings > 0) {
+    json.key("drag").begin_object().key("rings").value(result.drag.rings).key("nodes").value(result.drag.nodes);
+    json.key("inverted_tets").value(result.drag.inverted_tets).end_object();
+  }
   if (smoothed) write_smoothing(json, result.smoothing, result.smoothing_seconds);
   if (smoothed && result.improvement) write_improvement(json, *result.improvement, result.improvement_seconds);
   json.end_object();

@@ -245,6 +245,94 @@ void project_onto_surfaces(InsertionResult& result, std::span<const TriangleSurf
   }
 }
 
+// Every node within `rings` edge rings of a moved node (`moved`, with its `displacement`) but not moved
+// itself follows it, along the axes the box leaves it: by the mean full displacement of its neighbours
+// in the rings before, times 1 - r / R, r its distance from the moved nodes along the mesh's edges and R
+// the distance of the nearest node of ring rings + 1 (which, like every node beyond R, stays put; if the
+// rings hold the whole mesh, (rings + 1) / rings times the farthest dragged node's distance). The
+// tets beside the interface then keep their shape instead of being squeezed or inverted, and SUS has less
+// to do. The fade goes by distance, not by ring: by ring, the two ends of a tet's edge moved by shares
+// 1/(rings + 1) apart whatever its length, which crushed the metre-long tets of crease splits on faults.
+// Returns the number of nodes that moved.
+std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector<Eigen::Vector3d> displacement,
+                             int rings) {
+  const VertexTets stars = vertex_to_tets(mesh);
+  std::vector<double> distance(mesh.points.size(), std::numeric_limits<double>::infinity());
+  std::vector<VertexId> frontier, dragged;
+  for (VertexId v = 0; v < mesh.num_vertices(); ++v)
+    if (moved[v]) {
+      frontier.push_back(v);
+      distance[v] = 0.0;
+    }
+  double reach = std::numeric_limits<double>::infinity();  // R
+  for (int ring = 1; ring <= rings + 1 && !frontier.empty(); ++ring) {
+    std::vector<VertexId> next;
+    for (const VertexId v : frontier)
+      for (const TetId t : stars.of(v))
+        for (const VertexId w : mesh.tets[t])
+          if (!moved[w]) {
+            moved[w] = 2;  // found in this ring
+            next.push_back(w);
+          }
+    std::ranges::sort(next);
+    next.erase(std::unique(next.begin(), next.end()), next.end());
+    for (const VertexId w : next) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int count = 0;
+      for (const TetId t : stars.of(w))
+        for (const VertexId u : mesh.tets[t])
+          if (moved[u] == 1) {
+            sum += displacement[u];
+            distance[w] = std::min(distance[w], distance[u] + (mesh.points[w] - mesh.points[u]).norm());
+            ++count;
+          }
+      displacement[w] = sum / count;
+      if (ring > rings) reach = std::min(reach, distance[w]);
+    }
+    for (const VertexId w : next) moved[w] = 1;
+    if (ring <= rings) dragged.insert(dragged.end(), next.begin(), next.end());
+    frontier = std::move(next);
+  }
+  if (reach == std::numeric_limits<double>::infinity() && !dragged.empty()) {  // the rings hold the whole mesh
+    double farthest = 0.0;
+    for (const VertexId w : dragged) farthest = std::max(farthest, distance[w]);
+    reach = farthest * (rings + 1) / rings;
+  }
+  std::int64_t followed = 0;
+  for (const VertexId w : dragged) {
+    if (!(distance[w] < reach)) continue;
+    ++followed;
+    Eigen::Vector3d d = (1.0 - distance[w] / reach) * displacement[w];
+    const std::uint8_t planes = mesh.meccano.box_planes(mesh.grid[w]);
+    for (int axis = 0; axis < 3; ++axis)
+      if (planes & (3u << (2 * axis))) d[axis] = 0.0;
+    mesh.points[w] += d;
+  }
+  return followed;
+}
+
+// The end of step 3: the nodes around the interfaces follow their nodes' moves onto S (drag_neighbours),
+// from `before`, the positions before the projection. Within a band only nodes SUS may move follow.
+void drag_rings_after_projection(InsertionResult& result, const std::vector<Eigen::Vector3d>& before,
+                                 const InsertionOptions& options) {
+  int rings = options.drag_rings;
+  if (options.smoothing.mode == SmoothingMode::band) rings = std::min(rings, options.smoothing.band_rings);
+  if (rings <= 0) return;
+  std::vector<std::uint8_t> moved(result.mesh.points.size(), 0);
+  std::vector<Eigen::Vector3d> displacement(result.mesh.points.size(), Eigen::Vector3d::Zero());
+  for (const SurfaceInsertion& inserted : result.surfaces)
+    for (const SurfaceProjection& projection : inserted.projections)
+      for (const VertexId v : projection.nodes) {
+        displacement[v] = result.mesh.points[v] - before[v];
+        moved[v] = 1;
+      }
+  result.drag.rings = rings;
+  result.drag.nodes = drag_neighbours(result.mesh, std::move(moved), std::move(displacement), rings);
+  result.drag.inverted_tets = count_inverted(result.mesh);
+  report(options, "drag: ", result.drag.nodes, " nodes within ", rings, " rings of the interfaces follow them; ",
+         result.drag.inverted_tets, " tets inverted");
+}
+
 // Step 4: untangling and smoothing, every surface's nodes moving within it.
 void untangle_and_smooth(InsertionResult& result, std::span<SurfaceProjection* const> projections,
                          const InsertionOptions& options) {
@@ -302,7 +390,9 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
   check_stage(result.mesh, "approximation");
   if (options.last_stage == Stage::approximation) return result;
 
+  const std::vector<Eigen::Vector3d> before_projection = result.mesh.points;
   project_onto_surfaces(result, surfaces, trees, options, require_coverage);
+  drag_rings_after_projection(result, before_projection, options);
   const auto check = verify_mesh(result.mesh, {.physical = false});
   if (!check.ok()) throw MeshingError("mesh invalid after the projection stage: " + check.summary());
   result.quality_before_smoothing = summarize_quality(result.mesh);
@@ -836,68 +926,6 @@ std::unique_ptr<ParametricSurface> moved_parameterization(const ParametricSurfac
   return std::make_unique<ParametricSurface>(DiskView(moved), parameterization);
 }
 
-// Every node within `rings` edge rings of a moved node (`moved`, with its `displacement`) but not moved
-// itself follows it, along the axes the box leaves it: by the mean full displacement of its neighbours
-// in the rings before, times 1 - r / R, r its distance from the moved nodes along the mesh's edges and R
-// the distance of the nearest node of ring rings + 1 (which, like every node beyond R, stays put; if the
-// rings hold the whole mesh, (rings + 1) / rings times the farthest dragged node's distance). The
-// tets beside the interface then keep their shape instead of being squeezed or inverted, and SUS has less
-// to do. The fade goes by distance, not by ring: by ring, the two ends of a tet's edge moved by shares
-// 1/(rings + 1) apart whatever its length, which crushed the metre-long tets of crease splits on faults.
-void drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector<Eigen::Vector3d> displacement,
-                     int rings) {
-  const VertexTets stars = vertex_to_tets(mesh);
-  std::vector<double> distance(mesh.points.size(), std::numeric_limits<double>::infinity());
-  std::vector<VertexId> frontier, dragged;
-  for (VertexId v = 0; v < mesh.num_vertices(); ++v)
-    if (moved[v]) {
-      frontier.push_back(v);
-      distance[v] = 0.0;
-    }
-  double reach = std::numeric_limits<double>::infinity();  // R
-  for (int ring = 1; ring <= rings + 1 && !frontier.empty(); ++ring) {
-    std::vector<VertexId> next;
-    for (const VertexId v : frontier)
-      for (const TetId t : stars.of(v))
-        for (const VertexId w : mesh.tets[t])
-          if (!moved[w]) {
-            moved[w] = 2;  // found in this ring
-            next.push_back(w);
-          }
-    std::ranges::sort(next);
-    next.erase(std::unique(next.begin(), next.end()), next.end());
-    for (const VertexId w : next) {
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      int count = 0;
-      for (const TetId t : stars.of(w))
-        for (const VertexId u : mesh.tets[t])
-          if (moved[u] == 1) {
-            sum += displacement[u];
-            distance[w] = std::min(distance[w], distance[u] + (mesh.points[w] - mesh.points[u]).norm());
-            ++count;
-          }
-      displacement[w] = sum / count;
-      if (ring > rings) reach = std::min(reach, distance[w]);
-    }
-    for (const VertexId w : next) moved[w] = 1;
-    if (ring <= rings) dragged.insert(dragged.end(), next.begin(), next.end());
-    frontier = std::move(next);
-  }
-  if (reach == std::numeric_limits<double>::infinity() && !dragged.empty()) {  // the rings hold the whole mesh
-    double farthest = 0.0;
-    for (const VertexId w : dragged) farthest = std::max(farthest, distance[w]);
-    reach = farthest * (rings + 1) / rings;
-  }
-  for (const VertexId w : dragged) {
-    if (!(distance[w] < reach)) continue;
-    Eigen::Vector3d d = (1.0 - distance[w] / reach) * displacement[w];
-    const std::uint8_t planes = mesh.meccano.box_planes(mesh.grid[w]);
-    for (int axis = 0; axis < 3; ++axis)
-      if (planes & (3u << (2 * axis))) d[axis] = 0.0;
-    mesh.points[w] += d;
-  }
-}
-
 }  // namespace
 
 InsertionResult move_surfaces(const InsertionResult& previous, std::span<const TriangleSurface> surfaces,
@@ -947,8 +975,9 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
       }
     moved.projection_seconds = seconds_since(moving);
   }
-  drag_neighbours(result.mesh, std::move(moved_node), std::move(displacement), move.drag_rings);
-  const std::int64_t inverted = count_inverted(result.mesh);
+  result.drag.rings = move.drag_rings;
+  result.drag.nodes = drag_neighbours(result.mesh, std::move(moved_node), std::move(displacement), move.drag_rings);
+  const std::int64_t inverted = result.drag.inverted_tets = count_inverted(result.mesh);
   for (SurfaceInsertion& moved : result.surfaces) {
     for (SurfaceProjection& projection : moved.projections) projection.stats.inverted_tets = inverted;
     const ProjectionStats stats = moved.projection_stats();

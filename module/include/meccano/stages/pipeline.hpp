@@ -82,7 +82,13 @@ struct InsertionOptions {
   Stage last_stage = Stage::smoothing;
   SurfaceApproximationOptions approximation;  // side rule, healing pass limit
   ProjectionOptions projection;               // Floater weights, creases followed
-  SmoothingOptions smoothing;                 // SUS mode, target and limits
+  // Once every S_M is on its surface, the nodes within this many edge rings of the interfaces follow their
+  // moves, fading with distance (within a band: at most band_rings), so that SUS starts from far fewer
+  // inverted tets (a fault at E/50: 786 instead of 32 167). Off by default: with 4 rings SUS was 0.9-1.5x
+  // as fast on the cube example and eight faults, and the worst tet moved by up to +-0.03 either way
+  // (doc/benchmarks.md). 0: S_M alone moves, as in the paper.
+  int drag_rings = 0;
+  SmoothingOptions smoothing;  // SUS mode, target and limits
   // After SUS: lift the worst tets by smoothing and flips (topology), by smoothing alone (smooth: keeps
   // every tet in the bisection hierarchy, for callers that refine the result further), or not at all.
   Improvement improve = Improvement::topology;
@@ -111,12 +117,20 @@ struct SurfaceInsertion {
   ProjectionStats projection_stats() const;
 };
 
+// The nodes that followed the interfaces at the end of step 3 (InsertionOptions::drag_rings).
+struct DragStats {
+  int rings = 0;  // 0: none followed
+  std::int64_t nodes = 0;
+  std::int64_t inverted_tets = 0;  // after they followed: what SUS starts from
+};
+
 struct InsertionResult {
   TetMesh mesh;
   std::vector<SurfaceInsertion> surfaces;
+  DragStats drag;
   SmoothingStats smoothing;
   double smoothing_seconds = 0.0;
-  QualitySummary quality_before_smoothing;      // right after projection (tets may be inverted)
+  QualitySummary quality_before_smoothing;      // right after projection and the drag (tets may be inverted)
   std::optional<ImprovementStats> improvement;  // when the improvement ran
   double improvement_seconds = 0.0;
   QualitySummary quality_after_smoothing;  // of the result: after SUS and the improvement

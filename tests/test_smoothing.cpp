@@ -246,14 +246,17 @@ std::vector<int> edge_rings_from_interface(const InsertionResult& result) {
   return ring;
 }
 
+// A spherical cap in the unit cube at l_r = 1/24, through `last_stage` with `options`' other settings.
+InsertionResult inserted_cap(InsertionOptions options, Stage last_stage) {
+  const TriangleSurface surface = testing::spherical_cap(16);
+  options.resolution = 1.0 / 24;
+  options.last_stage = last_stage;
+  return insert_surfaces(make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0), {&surface, 1}, options);
+}
+
 // In band mode only nodes within the band's rings of S_M move; the mesh is still untangled.
 TEST(Smoothing, BandModeMovesOnlyNodesNearTheSurface) {
-  const TriangleSurface surface = testing::spherical_cap(16);
-  const Box box{{0, 0, 0}, {1, 1, 1}};
-  InsertionOptions options;
-  options.resolution = 1.0 / 24;
-  options.last_stage = Stage::projection;
-  InsertionResult result = insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
+  InsertionResult result = inserted_cap({}, Stage::projection);
   const std::vector<Eigen::Vector3d> projected = result.mesh.points;
   const std::vector<int> ring = edge_rings_from_interface(result);
 
@@ -274,12 +277,8 @@ TEST(Smoothing, BandModeMovesOnlyNodesNearTheSurface) {
 // no farther than the band): S_M's nodes land where they did without, fewer tets are inverted, box nodes
 // stay on the box, nothing beyond the rings moves, and SUS then untangles the mesh as before.
 TEST(Smoothing, NodesNearTheInterfaceFollowItWithDragRings) {
-  const TriangleSurface surface = testing::spherical_cap(16);
-  const Box box{{0, 0, 0}, {1, 1, 1}};
   InsertionOptions options;
-  options.resolution = 1.0 / 24;
-  options.last_stage = Stage::projection;
-  const InsertionResult still = insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
+  const InsertionResult still = inserted_cap(options, Stage::projection);
   const std::vector<int> ring = edge_rings_from_interface(still);
   const std::int64_t inverted_without = still.surfaces[0].projection_stats().inverted_tets;
   ASSERT_GT(inverted_without, 0);
@@ -290,8 +289,7 @@ TEST(Smoothing, NodesNearTheInterfaceFollowItWithDragRings) {
     options.drag_rings = 4;
     options.smoothing.mode = mode;
     options.smoothing.band_rings = 2;
-    options.last_stage = Stage::projection;
-    const InsertionResult dragged = insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
+    const InsertionResult dragged = inserted_cap(options, Stage::projection);
     const int rings = mode == SmoothingMode::whole_mesh ? 4 : 2;
     EXPECT_EQ(dragged.drag.rings, rings);
     EXPECT_LT(dragged.drag.inverted_tets, inverted_without / 2);
@@ -305,8 +303,7 @@ TEST(Smoothing, NodesNearTheInterfaceFollowItWithDragRings) {
     EXPECT_EQ(followed, dragged.drag.nodes);
     EXPECT_GT(followed, 0);
 
-    options.last_stage = Stage::smoothing;
-    const InsertionResult smoothed = insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
+    const InsertionResult smoothed = inserted_cap(options, Stage::smoothing);
     EXPECT_TRUE(smoothed.smoothing.untangled());
     EXPECT_TRUE(verify_mesh(smoothed.mesh, {.physical = true}).ok());
   }

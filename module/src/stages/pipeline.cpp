@@ -311,13 +311,16 @@ std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std
   return followed;
 }
 
-// The end of step 3: the nodes around the interfaces follow their nodes' moves onto S (drag_neighbours),
-// from `before`, the positions before the projection. Within a band only nodes SUS may move follow.
-void drag_rings_after_projection(InsertionResult& result, const std::vector<Eigen::Vector3d>& before,
+// The rings drag_rings_after_projection moves: within a band only nodes SUS may move follow.
+int rings_to_drag(const InsertionOptions& options) {
+  return options.smoothing.mode == SmoothingMode::band ? std::min(options.drag_rings, options.smoothing.band_rings)
+                                                       : options.drag_rings;
+}
+
+// The end of step 3: the nodes within `rings` of the interfaces follow their nodes' moves onto S
+// (drag_neighbours), from `before`, the positions before the projection.
+void drag_rings_after_projection(InsertionResult& result, const std::vector<Eigen::Vector3d>& before, int rings,
                                  const InsertionOptions& options) {
-  int rings = options.drag_rings;
-  if (options.smoothing.mode == SmoothingMode::band) rings = std::min(rings, options.smoothing.band_rings);
-  if (rings <= 0) return;
   std::vector<std::uint8_t> moved(result.mesh.points.size(), 0);
   std::vector<Eigen::Vector3d> displacement(result.mesh.points.size(), Eigen::Vector3d::Zero());
   for (const SurfaceInsertion& inserted : result.surfaces)
@@ -390,9 +393,11 @@ InsertionResult run_stages(TetMesh mesh, std::span<const TriangleSurface> surfac
   check_stage(result.mesh, "approximation");
   if (options.last_stage == Stage::approximation) return result;
 
-  const std::vector<Eigen::Vector3d> before_projection = result.mesh.points;
+  const int rings = rings_to_drag(options);
+  const std::vector<Eigen::Vector3d> before_projection =
+      rings > 0 ? result.mesh.points : std::vector<Eigen::Vector3d>{};
   project_onto_surfaces(result, surfaces, trees, options, require_coverage);
-  drag_rings_after_projection(result, before_projection, options);
+  if (rings > 0) drag_rings_after_projection(result, before_projection, rings, options);
   const auto check = verify_mesh(result.mesh, {.physical = false});
   if (!check.ok()) throw MeshingError("mesh invalid after the projection stage: " + check.summary());
   result.quality_before_smoothing = summarize_quality(result.mesh);

@@ -84,7 +84,7 @@ struct InsertionOptions {
   ProjectionOptions projection;               // Floater weights, creases followed
   // Once every S_M is on its surface, the nodes within this many edge rings of the interfaces follow their
   // moves, fading with distance (within a band: at most band_rings), so that SUS starts from far fewer
-  // inverted tets (a fault at E/50: 786 instead of 32 167). Off by default: with 4 rings SUS was 0.9-1.5x
+  // inverted tets (a fault at E/50: 786 instead of 32 167). Off by default: with 4 rings SUS was 0.85-1.34x
   // as fast on the cube example and eight faults, and the worst tet moved by up to +-0.03 either way
   // (doc/benchmarks.md). 0: S_M alone moves, as in the paper.
   int drag_rings = 0;

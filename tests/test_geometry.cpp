@@ -625,5 +625,25 @@ TEST(Geometry, SideAboveAndBelowGraphPatches) {
   }
 }
 
+// The nearest point of a hull: a point, the middle of a segment, the foot on a face, the origin inside;
+// on random sets away from the origin, the optimality condition p·x ≥ |x|² for every point.
+TEST(Geometry, HullPointNearestOrigin) {
+  using V = Eigen::Vector3d;
+  auto nearest = [](std::vector<V> points) { return hull_point_nearest_origin(points); };
+  EXPECT_TRUE(nearest({V(2, 1, 0)}).isApprox(V(2, 1, 0)));
+  EXPECT_LT((nearest({V(1, 0, 0), V(0, 1, 0)}) - V(0.5, 0.5, 0)).norm(), 1e-12);
+  EXPECT_LT((nearest({V(1, 1, 2), V(1, -1, 2), V(1, 0, -3), V(4, 0, 0)}) - V(1, 0, 0)).norm(), 1e-12);
+  EXPECT_LT(nearest({V(1, 0, 0), V(-1, 0, 0), V(0, 1, 0)}).norm(), 1e-9);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<V> points(2 + trial % 7);
+    for (V& p : points) p = V(coordinate(rng), coordinate(rng), coordinate(rng)) + V(1.2, 0.3, 0.0);
+    const V x = hull_point_nearest_origin(points);
+    ASSERT_GT(x.norm(), 0.0);
+    for (const V& p : points) EXPECT_GE(p.dot(x), (1 - 1e-9) * x.squaredNorm()) << "trial " << trial;
+  }
+}
+
 }  // namespace
 }  // namespace meccano

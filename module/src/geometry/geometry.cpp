@@ -1,6 +1,9 @@
 #include <meccano/geometry/geometry.hpp>
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -10,6 +13,42 @@
 namespace meccano {
 
 namespace {
+
+// The point of the simplex's hull nearest the origin; keeps in `simplex` only the corners that carry it.
+// Every face (subset of corners) is tried: its affine hull's nearest point counts when it lies inside the
+// face (all barycentric weights positive), and the nearest of those is the answer.
+Eigen::Vector3d nearest_point_of_simplex(std::vector<Eigen::Vector3d>& simplex) {
+  const auto corners = static_cast<int>(simplex.size());
+  Eigen::Vector3d best = simplex.front();
+  int best_face = 1;
+  for (int face = 1; face < (1 << corners); ++face) {
+    std::array<int, 4> in{};
+    int count = 0;
+    for (int i = 0; i < corners; ++i)
+      if (face & (1 << i)) in[count++] = i;
+    const Eigen::Vector3d& origin = simplex[in[0]];
+    const int k = count - 1;
+    if (k > 0) {
+      using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
+      Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3> edges(3, k);
+      for (int j = 0; j < k; ++j) edges.col(j) = simplex[in[j + 1]] - origin;
+      const Small gram = edges.transpose() * edges;
+      const Eigen::LDLT<Small> solver(gram);
+      if (solver.info() != Eigen::Success || !(solver.vectorD().cwiseAbs().minCoeff() > 1e-14 * gram.trace())) continue;
+      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1> weights = solver.solve(-edges.transpose() * origin);
+      if ((weights.array() <= 0.0).any() || weights.sum() >= 1.0) continue;
+      const Eigen::Vector3d point = origin + edges * weights;
+      if (point.squaredNorm() < best.squaredNorm()) best = point, best_face = face;
+    } else if (origin.squaredNorm() < best.squaredNorm()) {
+      best = origin, best_face = face;
+    }
+  }
+  std::vector<Eigen::Vector3d> carriers;
+  for (int i = 0; i < corners; ++i)
+    if (best_face & (1 << i)) carriers.push_back(simplex[i]);
+  simplex = std::move(carriers);
+  return best;
+}
 
 using Eigen::Vector3d;
 
@@ -228,6 +267,26 @@ double tetrahedron_longest_edge(const Tetrahedron3& tet) {
     for (int j = i + 1; j < 4; ++j) longest2 = std::max(longest2, (tet[i] - tet[j]).squaredNorm());
   }
   return std::sqrt(longest2);
+}
+
+Eigen::Vector3d hull_point_nearest_origin(std::span<const Eigen::Vector3d> points) {
+  // GJK's distance algorithm: the nearest point of a simplex of at most four of the points, which then
+  // takes in the point furthest back along it, until none is.
+  std::vector<Eigen::Vector3d> simplex{points.front()};
+  Eigen::Vector3d x = points.front();
+  for (std::size_t step = 0; step <= points.size() + 8; ++step) {
+    const Eigen::Vector3d* support = &points.front();
+    for (const Eigen::Vector3d& p : points)
+      if (p.dot(x) < support->dot(x)) support = &p;
+    if (x.squaredNorm() - support->dot(x) <= 1e-12 * x.squaredNorm() ||
+        std::find(simplex.begin(), simplex.end(), *support) != simplex.end())
+      break;
+    simplex.push_back(*support);
+    x = nearest_point_of_simplex(simplex);
+    if (simplex.size() == 4 || x.squaredNorm() <= 1e-28 * support->squaredNorm())
+      return Eigen::Vector3d::Zero();  // the origin is inside a tetrahedron of them (or on its face)
+  }
+  return x;
 }
 
 bool triangle_intersects_tetrahedron(const Triangle3& tri, const Tetrahedron3& tet) {

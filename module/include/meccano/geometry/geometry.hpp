@@ -36,6 +36,11 @@ inline double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { retur
 
 double tetrahedron_longest_edge(const Tetrahedron3& tet);
 
+// The point x of the convex hull of `points` (at least one) nearest the origin, by GJK's distance
+// algorithm: every point p then has p·x ≥ (1 − 1e-12)|x|², so a step along x raises every p·d at once. For
+// gradients, x is the steepest ascent direction of their minimum, and zero at a max-min optimum.
+Eigen::Vector3d hull_point_nearest_origin(std::span<const Eigen::Vector3d> points);
+
 // Whether the triangle meets the closed tetrahedron: a separating axis test (axis-aligned directions,
 // triangle normal, the 4 face normals, the 18 cross products of a triangle edge and a tetrahedron edge).
 // An axis separates only if the gap exceeds 1e-12 L, far above the rounding error of the projections,

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <random>
@@ -134,6 +135,37 @@ TEST(DihedralAngles, MatchTheCornerAndRegularTets) {
   const double regular_angle = std::acos(1.0 / 3) * 180 / std::numbers::pi;
   for (double angle : dihedral_angles_deg(regular)) EXPECT_NEAR(angle, regular_angle, 1e-12);
   EXPECT_NEAR(mean_ratio_equilateral(regular), 1.0, 1e-15);
+}
+
+// The shape ratios: 1 where a tet meets its floors exactly, each angle's ratio from its own dihedral angle,
+// +infinity for floors that are off, and not positive for an inverted or flat tet.
+TEST(ShapeOverFloors, MeasureEachAngleAndTheMeanRatioAgainstTheirFloors) {
+  const double corner_face = std::acos(1 / std::sqrt(3.0)) * 180 / std::numbers::pi;
+  const TetPoints corner{Eigen::Vector3d{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const ShapeFloors exact{corner_face, 90.0, mean_ratio_equilateral(corner)};  // the corner's angles: 54.7° and 90°
+  for (double ratio : shape_over_floors(corner, exact)) EXPECT_NEAR(ratio, 1.0, 1e-12);
+
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  const ShapeFloors floors;
+  for (int trial = 0; trial < 20; ++trial) {
+    TetPoints p;
+    for (auto& x : p) x = {coordinate(rng), coordinate(rng), coordinate(rng)};
+    if (signed_volume(p[0], p[1], p[2], p[3]) < 0) std::swap(p[0], p[1]);
+    const auto angles = dihedral_angles_deg(p);
+    const auto ratios = shape_over_floors(p, floors);
+    for (int e = 0; e < 6; ++e)
+      EXPECT_NEAR(ratios[e], std::min(angles[e] / 15.0, (180.0 - angles[e]) / 30.0), 1e-12) << "edge " << e;
+    EXPECT_NEAR(ratios[6], mean_ratio_equilateral(p) / 0.35, 1e-12);
+    EXPECT_EQ(worst_shape_over_floors(p, floors), *std::min_element(ratios.begin(), ratios.end()));
+  }
+
+  for (double ratio : shape_over_floors(corner, {0.0, 180.0, 0.0}))
+    EXPECT_EQ(ratio, std::numeric_limits<double>::infinity());
+  const TetPoints inverted{corner[0], corner[2], corner[1], corner[3]};
+  EXPECT_LT(worst_shape_over_floors(inverted, floors), 0.0);
+  const TetPoints flat{corner[0], corner[1], corner[2], Eigen::Vector3d{0.3, 0.3, 0.0}};
+  EXPECT_LE(worst_shape_over_floors(flat, floors), 0.0);
 }
 
 TEST(QualitySummary, UntouchedCubeHasMeccanoQualityOneAndKuhnClassValues) {

@@ -90,6 +90,27 @@ std::array<double, 6> dihedral_angles_deg(const TetPoints& p) {
   return angles;
 }
 
+std::array<double, 7> shape_over_floors(const TetPoints& p, const ShapeFloors& floors) {
+  constexpr double off = std::numeric_limits<double>::infinity();
+  const double below = floors.min_dihedral_deg > 0.0 ? 1.0 / floors.min_dihedral_deg : 0.0;
+  const double above = floors.max_dihedral_deg < 180.0 ? 1.0 / (180.0 - floors.max_dihedral_deg) : 0.0;
+  std::array<double, 7> ratios{};
+  const std::array<double, 6> cosines = dihedral_cosines(p);
+  for (int e = 0; e < 6; ++e) {
+    const double angle = degrees_from_cosine(cosines[e]);
+    ratios[e] = std::isnan(angle)
+                    ? 0.0  // a degenerate face
+                    : std::min(below > 0.0 ? angle * below : off, above > 0.0 ? (180.0 - angle) * above : off);
+  }
+  ratios[6] = floors.mean_ratio > 0.0 ? mean_ratio_equilateral(p) / floors.mean_ratio : off;
+  return ratios;
+}
+
+double worst_shape_over_floors(const TetPoints& p, const ShapeFloors& floors) {
+  const std::array<double, 7> ratios = shape_over_floors(p, floors);
+  return *std::min_element(ratios.begin(), ratios.end());
+}
+
 TetPoints oriented_points(const TetMesh& mesh, TetId t) {
   const auto v = mesh.oriented_tet(t);
   return {mesh.points[v[0]], mesh.points[v[1]], mesh.points[v[2]], mesh.points[v[3]]};

@@ -36,6 +36,19 @@ double mean_ratio_equilateral_cubed(const TetPoints& p);
 double mean_ratio_relative(const TetPoints& physical, const TetPoints& computational);
 std::array<double, 6> dihedral_angles_deg(const TetPoints& p);
 
+// Floors on a tet's shape (issue 18's targets): every dihedral angle within [min_dihedral_deg,
+// max_dihedral_deg] and the equilateral mean ratio at least mean_ratio. 0°, 180° or 0 turn a floor off.
+struct ShapeFloors {
+  double min_dihedral_deg = 15.0, max_dihedral_deg = 150.0, mean_ratio = 0.35;
+  bool angles_off() const { return min_dihedral_deg <= 0.0 && max_dihedral_deg >= 180.0; }
+};
+// A tet's shape as ratios to the floors, 1 where a floor is just met: per dihedral angle θ (edges 01, 02,
+// 03, 12, 13, 23) min(θ / min_dihedral_deg, (180° − θ) / (180° − max_dihedral_deg)), then the equilateral
+// mean ratio over mean_ratio (negative for an inverted tet). A floor that is off gives +infinity.
+std::array<double, 7> shape_over_floors(const TetPoints& p, const ShapeFloors& floors);
+// The smallest of them: below 1 when the tet misses a floor, not positive when it is inverted.
+double worst_shape_over_floors(const TetPoints& p, const ShapeFloors& floors);
+
 // Per-tet helpers on a mesh, in positively oriented order. The computational points are the undeformed
 // meccano positions in physical units (MeccanoGrid::to_physical), so that an untouched tet is its own
 // counterpart (q = 1) even when the meccano cells are not cubes.

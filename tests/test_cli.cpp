@@ -143,6 +143,10 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
        "--improve harder: the modes are topology, smooth and none"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --improve-threshold 0 --output " + path("a.msh"),
        "--improve-threshold must be above 0 and at most 1"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --improve-angles 15 --output " + path("a.msh"),
+       "--improve-angles takes 2 comma-separated numbers"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --improve-angles 75,150 --output " + path("a.msh"),
+       "--improve-angles takes MIN,MAX in degrees with 0 <= MIN < 70.5 < MAX <= 180"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --side up --output " + path("a.msh"),
        "the rules are positive, negative, positive-only and negative-only"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --threads 0 --output " + path("a.msh"),
@@ -213,10 +217,28 @@ TEST_F(CliTest, EverySmoothingSweepHasAProgressLine) {
   EXPECT_NE(run.output.find(" tets inverted, quality min "), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("improvement: "), std::string::npos) << run.output;
   EXPECT_NE(run.output.find(" rounds of flips: "), std::string::npos) << "topology is the default\n" << run.output;
+  EXPECT_NE(run.output.find("improvement shape pass 1: "), std::string::npos) << "angle floors are the default\n"
+                                                                              << run.output;
 
   const CliRun quiet = run_cli(arguments + " --quiet");
   ASSERT_EQ(quiet.status, 0) << quiet.output;
   EXPECT_TRUE(quiet.output.empty()) << "--quiet printed: " << quiet.output;
+}
+
+// --improve-angles sets the shape passes' floors; 0,180 turns them off.
+TEST_F(CliTest, ImproveAnglesSetsTheShapePassesFloors) {
+  const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
+  auto shape_passes = [&](const std::string& angles) {
+    const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + surface + " --resolution 0.1 --improve smooth " +
+                               angles + " --quiet --output " + path("mesh.msh") + " --report " + path("r.json"));
+    EXPECT_EQ(run.status, 0) << run.output;
+    std::ifstream file(path("r.json"));
+    const std::string report((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    const std::size_t at = report.find("\"shape_passes\": ");
+    return at == std::string::npos ? -1 : std::stoi(report.substr(at + 16));
+  };
+  EXPECT_EQ(shape_passes("--improve-angles 0,180"), 0);
+  EXPECT_GT(shape_passes("--improve-angles 20,140"), 0);
 }
 
 TEST_F(CliTest, VolumetricStageWritesOneGroupPerSurface) {
@@ -335,6 +357,9 @@ TEST_F(CliTest, FullPipelineWritesAnUntangledMeshAReportAndHistograms) {
                           "\"improvement\"",
                           "\"tets_below_threshold_before\"",
                           "\"min_equilateral_quality_after\"",
+                          "\"shape_passes\"",
+                          "\"tets_outside_floors_before\"",
+                          "\"tets_outside_floors_after\"",
                           "\"operations\"",
                           "\"flips_2_3\"",
                           "\"flips_3_2\"",

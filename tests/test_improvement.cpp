@@ -1,7 +1,8 @@
 // Lifting the worst tets after SUS (stages/improvement.hpp): slivers made on purpose are lifted, the equilateral
 // minimum never falls and the meccano one not below min(before, threshold), box nodes stay on their sides,
 // the result does not depend on the thread count, and on real insertions the S_M nodes stay on S
-// (test_smoothing and test_real_surfaces run the pipeline, which improves by default). Flips: the mesh
+// (test_smoothing and test_real_surfaces run the pipeline, which improves by default). The shape passes
+// widen the worst dihedral angles without lowering either mean ratio's minimum. Flips: the mesh
 // stays conforming with its box sides tagged and flipped tets leave the bisection hierarchy
 // (test_flips_pipeline runs them through the pipeline).
 
@@ -132,6 +133,52 @@ TEST(Improvement, RunsAfterSmoothingAndKeepsTheInterfaceOnS) {
   }
 }
 
+
+// The shape passes, on curved, creased, irregular and stacked surfaces: against the same insertion without
+// them, the worst dihedral angle against its floor (15° or 150°) improves (the cases' worst tets miss them),
+// neither mean ratio's minimum falls below what the passes keep, the mesh stays valid, and the S_M nodes
+// stay on S.
+TEST(Improvement, ShapePassesWidenTheWorstAnglesAndKeepTheInterfaceOnS) {
+  const std::vector<std::string> names{"spherical_cap_unit_cube_lr32", "paper_like_unit_cube_lr32",
+                                       "perturbed_paper_like_unit_cube_lr16", "stacked_pair_2x1x1_box_lr16"};
+  int tried = 0;
+  for (const auto& c : testing::surface_cases(16, false)) {
+    if (std::find(names.begin(), names.end(), c.name) == names.end()) continue;
+    SCOPED_TRACE(c.name);
+    ++tried;
+    InsertionOptions options;
+    options.resolution = c.resolution;
+    options.improve = Improvement::smooth;
+    options.improvement.min_dihedral = 0.0;
+    options.improvement.max_dihedral = 180.0;
+    const InsertionResult plain = insert_surfaces(make_cube_meccano(c.box, 0), c.surfaces, options);
+    options.improvement.min_dihedral = ImprovementOptions{}.min_dihedral;
+    options.improvement.max_dihedral = ImprovementOptions{}.max_dihedral;
+    const InsertionResult shaped = insert_surfaces(make_cube_meccano(c.box, 0), c.surfaces, options);
+    ASSERT_EQ(plain.improvement->shape_passes, 0);
+    ASSERT_GT(shaped.improvement->shape_passes, 0);
+    const QualitySummary& before = plain.quality_after_smoothing;
+    const QualitySummary& after = shaped.quality_after_smoothing;
+    // The worst angle against its floor: the passes raise the mesh's worst, and may trade an angle that
+    // is better than it (the smallest angle for the largest, say).
+    auto worst_angle_ratio = [](const QualitySummary& q) {
+      return std::min(q.min_dihedral_deg / 15.0, (180.0 - q.max_dihedral_deg) / 30.0);
+    };
+    ASSERT_LT(worst_angle_ratio(before), 1.0) << "no tet missed the floors";
+    EXPECT_GT(worst_angle_ratio(after), worst_angle_ratio(before));
+    EXPECT_LT(shaped.improvement->tets_outside_floors_after, shaped.improvement->tets_outside_floors_before);
+    const double threshold = options.improvement.threshold;
+    EXPECT_GE(after.equilateral.min, std::min(before.equilateral.min, threshold));
+    EXPECT_GE(after.meccano.min, std::min(before.meccano.min, threshold));
+    EXPECT_TRUE(verify_mesh(shaped.mesh, {.physical = true}).ok());
+    for (std::size_t s = 0; s < c.surfaces.size(); ++s) {
+      const TriangleBVH tree(c.surfaces[s]);
+      for (VertexId v : shaped.surfaces[s].projections.front().nodes)
+        ASSERT_LE(std::sqrt(tree.closest_point(shaped.mesh.points[v]).squared_distance), 1e-12 * c.box.diagonal());
+    }
+  }
+  EXPECT_EQ(tried, static_cast<int>(names.size()));
+}
 
 // The box-side faces as (sorted vertices, tag): flips must keep every one.
 std::map<std::array<VertexId, 3>, FaceTag> box_faces(const TetMesh& mesh) {

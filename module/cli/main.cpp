@@ -117,12 +117,16 @@ Options:
                            optimisation alone. none: SUS's mesh as it is
   --improve-threshold Q    the equilateral mean ratio below which a tet is improved (default 0.35;
                            higher costs more time)
+  --improve-angles MIN,MAX after the mean ratio, the nodes of tets with a dihedral angle below MIN or
+                           above MAX degrees (or a mean ratio below the threshold) raise their star's
+                           worst shape against these floors (default 15,150; 0,180: no shape passes)
   --threads N              OpenMP threads (default: all cores); the result does not depend on it
   --report FILE.json       timings, counts and quality before and after smoothing (keys: tets, nodes,
                            inverted, quality.before_smoothing / after_smoothing with meccano and
                            equilateral min, mean, std, after_smoothing being the result's, after the
                            improvement; min_dihedral_deg; seconds per stage and total; improvement:
                            passes, tets below the threshold and smallest quality before and after,
+                           shape_passes, tets_outside_floors_before / after,
                            rounds, operations by kind, tets removed and created, remeshed_tets)
   --histograms FILE.csv    quality histograms before and after smoothing, both measures (plot them
                            with scripts/plot_quality.py)
@@ -231,6 +235,8 @@ struct Options {
   meccano::SmoothingOptions smoothing;
   meccano::Improvement improve = meccano::InsertionOptions{}.improve;
   double improve_threshold = meccano::ImprovementOptions{}.threshold;
+  std::array<double, 2> improve_angles{meccano::ImprovementOptions{}.min_dihedral,
+                                       meccano::ImprovementOptions{}.max_dihedral};
   std::optional<int> threads;
   std::int64_t max_tets = meccano::default_max_tets;
   int finer_retries = meccano::InsertionOptions{}.finer_retries;
@@ -341,6 +347,13 @@ void declare_method_options(ArgumentParser& parser, Options& options) {
     options.improve_threshold = meccano::tools::parse_numbers("--improve-threshold", text, 1)[0];
     if (!(options.improve_threshold > 0.0 && options.improve_threshold <= 1.0))
       throw UsageError("--improve-threshold must be above 0 and at most 1");
+  });
+  parser.value({"--improve-angles"}, [&](const std::string& text) {
+    const auto angles = meccano::tools::parse_numbers("--improve-angles", text, 2);
+    // A regular tet's dihedral angle, 70.53°, must meet both floors.
+    if (!(angles[0] >= 0.0 && angles[0] < 70.5 && angles[1] > 70.6 && angles[1] <= 180.0))
+      throw UsageError("--improve-angles takes MIN,MAX in degrees with 0 <= MIN < 70.5 < MAX <= 180");
+    options.improve_angles = {angles[0], angles[1]};
   });
   parser.value({"--max-sweeps"}, store_integer("--max-sweeps", options.smoothing.max_sweeps, 1));
   parser.value({"--finer-retries"}, store_integer("--finer-retries", options.finer_retries, 0));
@@ -494,6 +507,8 @@ meccano::InsertionOptions insertion_options(const Options& options) {
   insertion.drag_rings = options.drag_rings;
   insertion.improve = options.improve;
   insertion.improvement.threshold = options.improve_threshold;
+  insertion.improvement.min_dihedral = options.improve_angles[0];
+  insertion.improvement.max_dihedral = options.improve_angles[1];
   insertion.max_tets = options.max_tets;
   insertion.finer_retries = options.finer_retries;
   return insertion;

@@ -92,6 +92,10 @@ void write_improvement(JsonWriter& json, const ImprovementStats& s, double secon
   json.key("node_updates").value(s.node_updates).key("nodes_moved").value(s.nodes_moved);
   json.key("min_equilateral_quality_before").value(s.min_quality_before);
   json.key("min_equilateral_quality_after").value(s.min_quality_after);
+  json.key("shape_passes").value(s.shape_passes);
+  json.key("shape_node_updates").value(s.shape_node_updates).key("shape_nodes_moved").value(s.shape_nodes_moved);
+  json.key("tets_outside_floors_before").value(s.tets_outside_floors_before);
+  json.key("tets_outside_floors_after").value(s.tets_outside_floors_after);
   json.key("rounds").value(s.rounds);
   json.key("operations").begin_object();
   json.key("flips_2_3").value(s.flips.flips_2_3).key("flips_3_2").value(s.flips.flips_3_2);

@@ -2,6 +2,7 @@
 
 #include <meccano/stages/improvement.hpp>
 
+#include <meccano/geometry/geometry.hpp>
 #include <meccano/mesh/quality.hpp>
 
 #include <Eigen/Dense>
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <optional>
 
@@ -117,6 +119,13 @@ double raise(double f, double power) {
   return std::pow(f, power);
 }
 
+// The star's worst exact distortion at d (infinite if a tet is inverted).
+double worst_exact_distortion(std::span<const StarTet> tets, const Vector3d& d) {
+  double largest = 0.0;
+  for (const StarTet& tet : tets) largest = std::max(largest, exact_distortion_at(tet, d));
+  return largest;
+}
+
 // Adds f^p and its derivatives: ∇(f^p) = p f^(p-1) ∇f, ∇²(f^p) = p f^(p-1) ∇²f + p(p-1) f^(p-2) ∇f ∇fᵀ.
 void add_power(const Distortion& d, double power, Distortion& sum) {
   if (power == 1.0) {
@@ -167,6 +176,10 @@ struct NodeFreedom {
 
 // Where a node is: its position and, on a surface, its parameters and the triangle holding them (and on
 // a crease, its arc length along the line).
+struct ChordStray {
+  double tilt = 0.0, sag = 0.0;  // radians, length
+};
+
 struct Placement {
   Vector3d x;
   Vector2d uv = Vector2d::Zero();
@@ -270,6 +283,8 @@ class Smoother {
   bool move(VertexId v, const Placement& from, const Parameters& step, Placement& to) const;
   bool keeps_surface_embedded(const NodeFreedom& node, const Vector2d& uv) const;
   bool optimise(VertexId v);
+  bool lift_worst_shape(VertexId v);
+  ChordStray chord_stray(VertexId v, const Placement& at) const;
   void store(VertexId v, const Placement& at);
   SweepRecord measure() const;
 
@@ -319,6 +334,9 @@ class Smoother {
   double untangling_epsilon_ = initial_untangling_epsilon;  // ε / mean|σ|, raised while untangling stalls
   const ImprovementOptions* improving_ = nullptr;           // set while improve() runs
   std::vector<Matrix3d> guard_inverses_;                    // improving: the meccano target's W^-1, per shape
+  ShapeFloors floors_;                                      // improving: what the shape passes aim at
+  double shape_mean_ratio_floor_ = 0.0;                     // shape passes: no tet's η / threshold below it
+  double shape_meccano_floor_ = 0.0;                        // shape passes: nor its meccano η below it
   std::vector<std::uint32_t> guard_of_tet_;
 };
 
@@ -599,13 +617,9 @@ bool Smoother::optimise(VertexId v) {
   // and towards the meccano targets, which may rise only up to 1 / threshold (so a star's meccano minimum
   // either stays or stays above the threshold, and the mesh's meccano minimum cannot fall below
   // min(before, threshold): the paper's measure is not traded away where it is already poor).
-  auto worst = [](std::span<const StarTet> tets, const Vector3d& d) {
-    double largest = 0.0;
-    for (const StarTet& tet : tets) largest = std::max(largest, exact_distortion_at(tet, d));
-    return largest;
-  };
-  double worst_at = improving_ ? worst(star, Vector3d::Zero()) : 0.0;
-  double guard_at = improving_ ? std::max(worst(guard, Vector3d::Zero()), 1.0 / improving_->threshold) : 0.0;
+  double worst_at = improving_ ? worst_exact_distortion(star, Vector3d::Zero()) : 0.0;
+  double guard_at =
+      improving_ ? std::max(worst_exact_distortion(guard, Vector3d::Zero()), 1.0 / improving_->threshold) : 0.0;
   const int steps = improving_ ? improving_->newton_steps
                     : tangled_ ? 2 * options_.newton_steps
                                : options_.newton_steps;
@@ -633,7 +647,8 @@ bool Smoother::optimise(VertexId v) {
       at_trial = last ? Distortion{star_objective(star, d)} : star_derivatives(star, d);
       accepted = at_trial.value <= value + 1e-4 * alpha * slope;
       if (accepted && improving_)
-        accepted = (worst_trial = worst(star, d)) <= worst_at && (guard_trial = worst(guard, d)) <= guard_at;
+        accepted = (worst_trial = worst_exact_distortion(star, d)) <= worst_at &&
+                   (guard_trial = worst_exact_distortion(guard, d)) <= guard_at;
     }
     if (!accepted) {
       stalled = true;
@@ -682,8 +697,10 @@ bool Smoother::optimise(VertexId v) {
         Placement trial;
         if (!move(v, from, step, trial)) continue;
         const Vector3d d = trial.x - start.x;
-        const double worst_trial = worst(star, d);
-        if (worst_trial >= best_worst || star_objective(star, d) >= model.value || worst(guard, d) > guard_at) continue;
+        const double worst_trial = worst_exact_distortion(star, d);
+        if (worst_trial >= best_worst || star_objective(star, d) >= model.value ||
+            worst_exact_distortion(guard, d) > guard_at)
+          continue;
         at = trial;
         best_worst = worst_trial;
       }
@@ -692,6 +709,150 @@ bool Smoother::optimise(VertexId v) {
   if (moved == 0.0) return false;
   store(v, at);
   return tangled_star || moved > 1e-2 * length;
+}
+
+// The shape passes' node update: a max-min ascent of the star's worst shape ratio (shape_over_floors: each
+// dihedral angle and the mean ratio against its floor). The Newton passes' Σ η^p hardly sees a tet whose
+// mean ratio is fine but whose dihedral angle is not: on the cube example at l_r = 1/64 the largest
+// angles, 158°, are in tets of η = 0.41 standing on S_M triangles of 124°. So the worst ratio is raised
+// directly. The gradients of the ratios within 0.02 of the worst are taken by differences in the node's
+// own parameters (in space, on its box planes or on S; each scaled to a length by its column of
+// dx/dparameters), and the step follows the point of their convex hull nearest the origin, no further
+// than the floors. It is taken only if the star's worst ratio rises, no mean ratio falls below the mesh's
+// minimum after the Newton passes (shape_mean_ratio_floor_; the paper's measure likewise, below its star's
+// worst: shape_meccano_floor_), and a node on S leaves its S_M triangles tilted from S by at most
+// max(5°, before) and sagging from it no more than before.
+bool Smoother::lift_worst_shape(VertexId v) {
+  // Rim and crease nodes stay: sliding along S's rim or crease lines moves the chords that follow those
+  // lines, and the interface's distance to S with them (on the faults, its Hausdorff distance grew up to 18 %).
+  const Freedom kind = freedom_[v].kind;
+  if (kind == Freedom::fixed || kind == Freedom::rim || kind == Freedom::crease) return false;
+  const auto [star, length, guard] = take_star(v);
+  const double guard_at = std::max(worst_exact_distortion(guard, Vector3d::Zero()), 1.0 / shape_meccano_floor_);
+  thread_local std::vector<std::pair<TetPoints, int>> tets;  // the star's points and v's place in each
+  thread_local std::vector<double> ratios, trial_ratios;
+  thread_local std::vector<Vector3d> gradients;
+  thread_local std::vector<std::size_t> active;  // the ratios within active_band of the worst
+  tets.clear();
+  for (TetId t : stars_.of(v)) {
+    TetPoints p;
+    int local = 0;
+    for (int i = 0; i < 4; ++i) {
+      p[i] = mesh_.points[oriented_[t][i]];
+      if (oriented_[t][i] == v) local = i;
+    }
+    tets.emplace_back(p, local);
+  }
+  // Every ratio of the star with v at x, into `out`; returns the smallest.
+  auto evaluate = [&](const Vector3d& x, std::vector<double>& out) {
+    out.clear();
+    double smallest = infinity;
+    for (auto [p, local] : tets) {
+      p[local] = x;
+      for (const double ratio : shape_over_floors(p, floors_)) {
+        out.push_back(ratio);
+        smallest = std::min(smallest, ratio);
+      }
+    }
+    return smallest;
+  };
+  constexpr double active_band = 0.02;
+  const double difference = 1e-7 * length;
+  const Placement start = placement(v);
+  Placement at = start, probe, trial;
+  double worst_ratio = evaluate(at.x, ratios);
+  auto smallest_mean_ratio = [](const std::vector<double>& of_star) {
+    double smallest = infinity;
+    for (std::size_t i = 6; i < of_star.size(); i += 7) smallest = std::min(smallest, of_star[i]);
+    return smallest;
+  };
+  // A node on S may slide only while its S_M triangles tilt from S no more than 5° or than before, and sag
+  // from it no more than before: the interface's normals and its distance to S are what its users check.
+  const ChordStray stray_before = chord_stray(v, start);
+  const double tilt_allowed = std::max(stray_before.tilt, 5.0 * std::numbers::pi / 180.0);
+  auto strays_no_further = [&](const Placement& moved_to) {
+    const ChordStray stray = chord_stray(v, moved_to);
+    return stray.tilt <= tilt_allowed && stray.sag <= stray_before.sag;
+  };
+  // Until the star meets the floors: beyond them the ascent would only trade the paper's measure (the
+  // counterparts' shapes) for angles nobody asked for.
+  for (int step = 0; step < improving_->ascent_steps && worst_ratio < 1.0; ++step) {
+    const Jacobian j = jacobian(v, at);
+    std::array<double, 3> scale{};
+    active.clear();
+    for (std::size_t i = 0; i < ratios.size(); ++i)
+      if (ratios[i] < worst_ratio + active_band) active.push_back(i);
+    gradients.assign(active.size(), Vector3d::Zero());
+    for (int k = 0; k < 3; ++k) {
+      scale[k] = j.col(k).norm();
+      if (scale[k] == 0.0) continue;
+      double sign = 1.0;
+      Parameters offset = Parameters::Zero();
+      offset[k] = difference / scale[k];
+      if (!move(v, at, offset, probe)) {
+        sign = -1.0;
+        if (!move(v, at, -offset, probe)) continue;
+      }
+      evaluate(probe.x, trial_ratios);
+      for (std::size_t a = 0; a < active.size(); ++a)
+        gradients[a][k] = sign * (trial_ratios[active[a]] - ratios[active[a]]) / difference;
+    }
+    const Vector3d direction = hull_point_nearest_origin(gradients);
+    const double norm = direction.norm();
+    if (!(norm > 1e-9 / length)) break;  // a max-min optimum within the node's freedom
+    bool accepted = false;
+    // The worst ratio rises at about `norm` per unit of length along the direction: no further than it
+    // takes to reach the floors, so that nodes move no more than the angles need.
+    const double first_reach = std::min(0.1 * length, (1.0 - worst_ratio) / norm);
+    for (double reach = first_reach; reach > 1e-4 * length && !accepted; reach *= 0.5) {
+      Parameters offset = Parameters::Zero();
+      for (int k = 0; k < 3; ++k)
+        if (scale[k] > 0.0) offset[k] = reach * direction[k] / (norm * scale[k]);
+      if (!move(v, at, offset, trial)) continue;
+      const double trial_worst = evaluate(trial.x, trial_ratios);
+      accepted = trial_worst > worst_ratio + 1e-9 && smallest_mean_ratio(trial_ratios) >= shape_mean_ratio_floor_ &&
+                 worst_exact_distortion(guard, trial.x - start.x) <= guard_at && strays_no_further(trial);
+      if (accepted) worst_ratio = trial_worst;
+    }
+    if (!accepted) break;
+    at = trial;
+    std::swap(ratios, trial_ratios);
+  }
+  if (at.x == start.x) return false;
+  store(v, at);
+  return true;
+}
+
+// How far S_M's triangles around surface node v, with v at `at`, stray from S: the largest angle between
+// a triangle and S at its parametric centroid, and the largest distance between the triangle's centroid
+// and that point of S (its sag). Zero for a node off the surfaces.
+ChordStray Smoother::chord_stray(VertexId v, const Placement& at) const {
+  const NodeFreedom& node = freedom_[v];
+  if (node.surface < 0) return {};
+  const SurfaceProjection& projection = *surfaces_[node.surface];
+  const ParametricSurface& surface = *projection.surface;
+  const auto& start = triangle_start_[node.surface];
+  double smallest_cosine = 1.0;
+  ChordStray stray;
+  for (int k = start[node.index]; k < start[node.index + 1]; ++k) {
+    const auto& corners = projection.triangles[node_triangles_[node.surface][k]];
+    std::array<Vector3d, 3> x;
+    Vector2d centroid = Vector2d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      const bool moved = corners[i] == node.index;
+      x[i] = moved ? at.x : mesh_.points[projection.nodes[corners[i]]];
+      centroid += (moved ? at.uv : projection.uv[corners[i]]) / 3.0;
+    }
+    const auto location = surface.locate(centroid, at.triangle);
+    stray.sag = std::max(stray.sag, ((x[0] + x[1] + x[2]) / 3.0 - surface.evaluate(location)).norm());
+    const Vector3d chord = (x[1] - x[0]).cross(x[2] - x[0]);
+    const Eigen::Matrix<double, 3, 2> tangents = surface.derivative(location.triangle);
+    const Vector3d normal = tangents.col(0).cross(tangents.col(1));
+    const double norms = chord.norm() * normal.norm();
+    if (norms > 0.0) smallest_cosine = std::min(smallest_cosine, std::abs(chord.dot(normal)) / norms);
+  }
+  stray.tilt = std::acos(std::clamp(smallest_cosine, -1.0, 1.0));
+  return stray;
 }
 
 void Smoother::store(VertexId v, const Placement& at) {
@@ -870,68 +1031,125 @@ SmoothingStats Smoother::run() {
 
 ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<const std::uint8_t> only) {
   improving_ = &options;
+  floors_ = {options.min_dihedral, options.max_dihedral, options.threshold};
   tangled_ = false;
   aim_at(SmoothingTarget::meccano);
   guard_inverses_ = std::move(target_inverses_);
   guard_of_tet_ = std::move(target_of_tet_);
   aim_at(SmoothingTarget::equilateral);
-  ImprovementStats stats;
-  std::vector<double> quality(mesh_.tets.size());
   std::vector<std::uint8_t> movable(mesh_.points.size(), 0);
   for (VertexId v : free_nodes()) movable[v] = only.empty() || only[v];
-  // The equilateral mean ratio of the given tets (those whose nodes may have moved).
-  auto measure_tets = [&](const std::vector<TetId>& tets) {
-    const auto count = static_cast<std::int64_t>(tets.size());
-#pragma omp parallel for schedule(static)
-    for (std::int64_t i = 0; i < count; ++i) quality[tets[i]] = mean_ratio_equilateral(oriented_points(mesh_, tets[i]));
-  };
-  // The worst tets' movable nodes, in vertex order.
-  auto worst_nodes = [&] {
-    std::vector<VertexId> nodes;
-    for (TetId t = 0; t < mesh_.num_tets(); ++t)
-      if (quality[t] < options.threshold)
-        for (VertexId v : mesh_.tets[t])
-          if (movable[v]) nodes.push_back(v);
-    std::sort(nodes.begin(), nodes.end());
-    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-    return nodes;
-  };
-  auto below_threshold = [&] {
-    return static_cast<std::int64_t>(
-        std::count_if(quality.begin(), quality.end(), [&](double q) { return q < options.threshold; }));
-  };
+  std::vector<double> quality(mesh_.tets.size());
   std::vector<TetId> all(mesh_.tets.size());
   std::iota(all.begin(), all.end(), TetId{0});
-  measure_tets(all);
-  std::vector<VertexId> nodes = worst_nodes();
-  stats.tets_below_before = below_threshold();
-  stats.min_quality_before = quality.empty() ? 0.0 : *std::min_element(quality.begin(), quality.end());
-  while (!nodes.empty() && stats.passes < options.max_passes) {
-    ++stats.passes;
-    std::int64_t moved = 0;
-    for (const auto& group : colour(nodes)) {
-      const auto size = static_cast<std::int64_t>(group.size());
+  // Passes over the tets whose quality (tet_quality) is below `limit`: each optimises their movable nodes
+  // with `update`, colour by colour, until none is left, none moves or max_passes have run. With
+  // skip_settled, a node that did not move is left out of the next pass unless a node of its star moved:
+  // its update depends on its star alone (the shape passes'; the Newton passes' reports only moves of
+  // 1 % of an edge).
+  struct Passes {
+    int count = 0;
+    std::int64_t updates = 0, moved = 0, below_before = 0, below_after = 0;
+    double min_before = 0.0, min_after = 0.0;
+  };
+  auto run_passes = [&](auto tet_quality, double limit, bool (Smoother::*update)(VertexId), bool skip_settled,
+                        const std::string& pass_name, const std::string& where) {
+    auto measure_tets = [&](const std::vector<TetId>& tets) {
+      const auto count = static_cast<std::int64_t>(tets.size());
+#pragma omp parallel for schedule(static)
+      for (std::int64_t i = 0; i < count; ++i) quality[tets[i]] = tet_quality(oriented_points(mesh_, tets[i]));
+    };
+    auto worst_nodes = [&] {  // in vertex order
+      std::vector<VertexId> nodes;
+      for (TetId t = 0; t < mesh_.num_tets(); ++t)
+        if (quality[t] < limit)
+          for (VertexId v : mesh_.tets[t])
+            if (movable[v]) nodes.push_back(v);
+      std::sort(nodes.begin(), nodes.end());
+      nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+      return nodes;
+    };
+    auto below = [&] {
+      return static_cast<std::int64_t>(
+          std::count_if(quality.begin(), quality.end(), [&](double q) { return q < limit; }));
+    };
+    auto smallest = [&] { return quality.empty() ? 0.0 : *std::min_element(quality.begin(), quality.end()); };
+    Passes passes;
+    measure_tets(all);
+    passes.below_before = below();
+    passes.min_before = smallest();
+    std::vector<std::uint8_t> moved_now(mesh_.points.size(), 0), settled(mesh_.points.size(), 0);
+    std::vector<VertexId> nodes = worst_nodes();
+    while (!nodes.empty() && passes.count < options.max_passes) {
+      ++passes.count;
+      std::int64_t moved = 0;
+      for (const auto& group : colour(nodes)) {
+        const auto size = static_cast<std::int64_t>(group.size());
 #pragma omp parallel for schedule(dynamic, 16) reduction(+ : moved)
-      for (std::int64_t i = 0; i < size; ++i) moved += optimise(group[i]);
+        for (std::int64_t i = 0; i < size; ++i) {
+          moved_now[group[i]] = (this->*update)(group[i]);
+          moved += moved_now[group[i]];
+        }
+      }
+      const std::size_t tried = nodes.size();
+      passes.updates += static_cast<std::int64_t>(tried);
+      passes.moved += moved;
+      std::vector<TetId> touched;
+      for (VertexId v : nodes) touched.insert(touched.end(), stars_.of(v).begin(), stars_.of(v).end());
+      std::sort(touched.begin(), touched.end());
+      touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+      measure_tets(touched);
+      if (skip_settled) {
+        for (VertexId v : nodes) settled[v] = !moved_now[v];
+        for (VertexId v : nodes)
+          if (moved_now[v])
+            for (TetId t : stars_.of(v))
+              for (VertexId w : mesh_.tets[t]) settled[w] = 0;
+      }
+      for (VertexId v : nodes) moved_now[v] = 0;
+      nodes = worst_nodes();
+      if (skip_settled) std::erase_if(nodes, [&](VertexId v) { return settled[v] != 0; });
+      if (options.progress)
+        options.progress("improvement " + pass_name + " pass " + std::to_string(passes.count) + ": " +
+                         std::to_string(moved) + " of " + std::to_string(tried) + " nodes moved; " +
+                         std::to_string(below()) + " tets " + where + ", smallest " + std::to_string(smallest()));
+      if (moved == 0) break;
     }
-    const std::size_t tried = nodes.size();
-    stats.node_updates += static_cast<std::int64_t>(tried);
-    stats.nodes_moved += moved;
-    std::vector<TetId> touched;
-    for (VertexId v : nodes) touched.insert(touched.end(), stars_.of(v).begin(), stars_.of(v).end());
-    std::sort(touched.begin(), touched.end());
-    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-    measure_tets(touched);
-    nodes = worst_nodes();
-    if (options.progress)
-      options.progress("improvement pass " + std::to_string(stats.passes) + ": " + std::to_string(moved) + " of " +
-                       std::to_string(tried) + " nodes moved; " + std::to_string(below_threshold()) +
-                       " tets below the threshold, smallest quality " +
-                       std::to_string(*std::min_element(quality.begin(), quality.end())));
-    if (moved == 0) break;
+    passes.below_after = below();
+    passes.min_after = smallest();
+    return passes;
+  };
+  ImprovementStats stats;
+  const Passes newton = run_passes([](const TetPoints& p) { return mean_ratio_equilateral(p); }, options.threshold,
+                                   &Smoother::optimise, false, "mean ratio", "below the threshold");
+  stats.passes = newton.count;
+  stats.node_updates = newton.updates;
+  stats.nodes_moved = newton.moved;
+  stats.tets_below_before = newton.below_before;
+  stats.tets_below_after = newton.below_after;
+  stats.min_quality_before = newton.min_before;
+  stats.min_quality_after = newton.min_after;
+  if (!floors_.angles_off()) {
+    // The shape passes trade either mean ratio for angles only above the mesh's minimum after the Newton
+    // passes: neither minimum falls.
+    shape_mean_ratio_floor_ = newton.min_after / options.threshold;
+    shape_meccano_floor_ = summarize_quality(mesh_).meccano.min;
+    // Most nodes of the tets left outside the floors are held (by the guards, or neighbours that stay):
+    // trying them again cost as much as the first pass for a few per cent of moves.
+    const Passes shape =
+        run_passes([&](const TetPoints& p) { return worst_shape_over_floors(p, floors_); }, 1.0,
+                   &Smoother::lift_worst_shape, true, "shape", "outside the floors (worst ratio to them)");
+    stats.shape_passes = shape.count;
+    stats.shape_node_updates = shape.updates;
+    stats.shape_nodes_moved = shape.moved;
+    stats.tets_outside_floors_before = shape.below_before;
+    stats.tets_outside_floors_after = shape.below_after;
+    // The shape passes may lower a mean ratio that stays above the worst ratio of its star.
+    for (TetId t = 0; t < mesh_.num_tets(); ++t) quality[t] = mean_ratio_equilateral(oriented_points(mesh_, t));
+    stats.tets_below_after =
+        std::count_if(quality.begin(), quality.end(), [&](double q) { return q < options.threshold; });
+    stats.min_quality_after = quality.empty() ? 0.0 : *std::min_element(quality.begin(), quality.end());
   }
-  stats.tets_below_after = below_threshold();
-  stats.min_quality_after = quality.empty() ? 0.0 : *std::min_element(quality.begin(), quality.end());
   improving_ = nullptr;
   return stats;
 }
@@ -981,6 +1199,10 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
     stats.nodes_moved += smoothed.nodes_moved;
     stats.tets_below_after = smoothed.tets_below_after;
     stats.min_quality_after = smoothed.min_quality_after;
+    stats.shape_passes += smoothed.shape_passes;
+    stats.shape_node_updates += smoothed.shape_node_updates;
+    stats.shape_nodes_moved += smoothed.shape_nodes_moved;
+    stats.tets_outside_floors_after = smoothed.tets_outside_floors_after;
   }
   for (TetId t = 0; t < mesh.num_tets(); ++t) stats.remeshed_tets += !mesh.bisectable(t);
   return stats;

@@ -18,6 +18,17 @@
 //          S_M nodes on S, rim nodes along the rim, crease nodes along the crease, S_M kept embedded).
 //          Nodes are coloured as in SUS, so the result does not depend on the thread count. In band mode
 //          only the band's nodes move, as in SUS.
+// Shapes   (min_dihedral > 0 or max_dihedral < 180) after those passes, in each round: Σ η^p hardly sees a
+//          tet whose mean ratio is fine but whose dihedral angle is not (the cube example's 158° tets have
+//          η = 0.41). The nodes of the tets with an angle outside [min_dihedral, max_dihedral] or a mean
+//          ratio below `threshold` each take up to `ascent_steps` steps of a max-min ascent of their star's
+//          worst shape_over_floors ratio (mesh/quality.hpp), along the nearest point of the hull of the
+//          near-worst ratios' gradients, no further than the floors, until the star meets them. A step
+//          must raise that worst ratio, keep every mean ratio (both measures) at least the mesh's minimum
+//          after the Newton passes or its star's worst, and leave a node on S with its S_M triangles
+//          tilted from S by at most max(5°, their tilt before) and sagging from it no more than before
+//          (the interface's normals and distance to S). Rim, crease and fixed nodes stay. A node that did
+//          not move is tried again only once a node of its star has moved.
 // Topology (options.topology) rounds of flips between smoothing passes: each tet below `threshold`, worst
 //          first, tries the 2-3 flip across each of its faces and the removal of each of its edges (the
 //          ring of m = 3..max_ring tets around the edge replaced by the best of the 2m-4-tet
@@ -39,7 +50,9 @@
 //          `smooth` the topology and the bisection hierarchy are untouched.
 // Limits   a tet whose four nodes cannot move and that no flip improves (box corners, nodes of two
 //          surfaces, shapes fixed by S's own triangles) stays as it is; no edge contraction, multi-face
-//          removal or vertex insertion away from creases, and no flips of box faces.
+//          removal or vertex insertion away from creases, and no flips of box faces. The shape passes
+//          cannot widen a tet standing on an S_M triangle of 150°+ whose nodes the guards hold (the worst
+//          left on the faults), and the flips choose by mean ratio alone, so they may narrow an angle.
 #pragma once
 
 #include <meccano/mesh/tet_mesh.hpp>
@@ -59,6 +72,11 @@ struct ImprovementOptions {
   int max_passes = 10;      // smoothing passes per round
   int newton_steps = 8;     // per node and pass
   double power = 8.0;       // p of the star's Σ η^p
+  // Shape passes after the Newton passes: the nodes of tets with a dihedral angle below min_dihedral or
+  // above max_dihedral (degrees), or a mean ratio below `threshold`, raise their star's worst shape
+  // against these floors (max-min). 0 and 180: no shape passes.
+  double min_dihedral = 15.0, max_dihedral = 150.0;
+  int ascent_steps = 16;    // per node and shape pass
   bool topology = false;    // flips and edge removal between the smoothing passes
   int rounds = 3;           // topology: at most this many rounds of flips, each followed by smoothing
   int max_flip_passes = 4;  // flip passes per round
@@ -89,8 +107,11 @@ struct ImprovementStats {
   std::int64_t node_updates = 0;                             // nodes optimised, over all passes
   std::int64_t nodes_moved = 0;                              // of those, the ones that moved
   double min_quality_before = 0.0, min_quality_after = 0.0;  // smallest equilateral mean ratio
-  FlipStats flips;                                           // topology
-  std::int64_t remeshed_tets = 0;                            // tets left not bisectable
+  int shape_passes = 0;                                      // over all rounds
+  std::int64_t shape_node_updates = 0, shape_nodes_moved = 0;
+  std::int64_t tets_outside_floors_before = 0, tets_outside_floors_after = 0;  // of the shape passes' floors
+  FlipStats flips;                                                             // topology
+  std::int64_t remeshed_tets = 0;                                              // tets left not bisectable
 };
 
 // `sus` gives the nodes that may move: those SUS moved (its mode and band); its other fields are unused.

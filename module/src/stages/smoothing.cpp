@@ -1144,7 +1144,8 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
     stats.shape_nodes_moved = shape.moved;
     stats.tets_outside_floors_before = shape.below_before;
     stats.tets_outside_floors_after = shape.below_after;
-    // The shape passes may lower a mean ratio that stays above the worst ratio of its star.
+    // The shape passes may lower mean ratios above the mesh's minimum: count the tets below the threshold
+    // again.
     for (TetId t = 0; t < mesh_.num_tets(); ++t) quality[t] = mean_ratio_equilateral(oriented_points(mesh_, t));
     stats.tets_below_after =
         std::count_if(quality.begin(), quality.end(), [&](double q) { return q < options.threshold; });

@@ -174,12 +174,13 @@ struct NodeFreedom {
   const CreaseLine* crease = nullptr;  // crease: the line of P it moves along
 };
 
-// Where a node is: its position and, on a surface, its parameters and the triangle holding them (and on
-// a crease, its arc length along the line).
+// How far S_M's triangles around a node stray from S (Smoother::chord_stray).
 struct ChordStray {
   double tilt = 0.0, sag = 0.0;  // radians, length
 };
 
+// Where a node is: its position and, on a surface, its parameters and the triangle holding them (and on
+// a crease, its arc length along the line).
 struct Placement {
   Vector3d x;
   Vector2d uv = Vector2d::Zero();
@@ -1045,8 +1046,8 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
   // Passes over the tets whose quality (tet_quality) is below `limit`: each optimises their movable nodes
   // with `update`, colour by colour, until none is left, none moves or max_passes have run. With
   // skip_settled, a node that did not move is left out of the next pass unless a node of its star moved:
-  // its update depends on its star alone (the shape passes'; the Newton passes' reports only moves of
-  // 1 % of an edge).
+  // its update depends on its star alone, so it would fail again. Not for the Newton passes: optimise
+  // reports only moves beyond 1 % of an edge, and a node it calls unmoved may have moved a little.
   struct Passes {
     int count = 0;
     std::int64_t updates = 0, moved = 0, below_before = 0, below_after = 0;

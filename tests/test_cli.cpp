@@ -366,6 +366,7 @@ TEST_F(CliTest, FullPipelineWritesAnUntangledMeshAReportAndHistograms) {
                           "\"flips_4_4\"",
                           "\"edge_removals\"",
                           "\"surface_edge_flips\"",
+                          "\"cap_flips\"",
                           "\"remeshed_tets\""})
     EXPECT_NE(report.find(key), std::string::npos) << key << " missing from\n" << report;
   std::ifstream histogram_file(path("q.csv"));

@@ -1,8 +1,8 @@
 // Flips through the pipeline (`Improvement::topology`, stages/improvement.hpp), on the irregular S_M of the
 // perturbed test surfaces at a threshold above the default, for hundreds of flips: the interface keeps its
 // orientation, S_M's triangle list stays the tagged faces, its nodes stay on S, no tet lies on one
-// surface, and the mesh is the same on 1 and 2 threads. The crease mends on a real fault. About a minute:
-// label `long`.
+// surface, and the mesh is the same on 1 and 2 threads. The crease mends and the cap flips on real faults.
+// About a minute: label `long`.
 
 #include <meccano/geometry/geometry.hpp>
 #include <meccano/inspect/mesh_file_measure.hpp>
@@ -68,7 +68,7 @@ void expect_interface_on_surface(const InsertionResult& result, std::span<const 
 
 // Smoothing and flips alternate; the interface stays on S and oriented like it.
 TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
-  std::int64_t surface_edge_flips = 0;
+  std::int64_t surface_edge_flips = 0, cap_flips = 0;
   for (const auto& c : testing::surface_cases(16, true)) {
     if (!c.name.ends_with("_perturbed_lr24")) continue;  // irregular S_M: the most flips
     SCOPED_TRACE(c.name);
@@ -81,6 +81,7 @@ TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
     const InsertionResult flipped = insert_surfaces(make_cube_meccano(c.box, 0), c.surfaces, options);
     ASSERT_TRUE(flipped.improvement.has_value());
     surface_edge_flips += flipped.improvement->flips.surface_edge_flips;
+    cap_flips += flipped.improvement->flips.cap_flips;
     const MeshInvariantReport check = verify_mesh(flipped.mesh, {.physical = true});
     ASSERT_TRUE(check.ok()) << check.summary();
     EXPECT_GE(flipped.quality_after_smoothing.equilateral.min, smoothed.improvement->min_quality_before);
@@ -89,6 +90,7 @@ TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
     expect_interface_on_surface(flipped, c.surfaces, c.box);
   }
   EXPECT_GT(surface_edge_flips, 0) << "no case flipped an edge inside S_M: that path went untested";
+  EXPECT_GT(cap_flips, 0) << "no case flipped an S_M cap: that path went untested";
 }
 
 // The crease mends on a real fault with creases of 20-45 degrees (Shell Beds at E/50, 1-2 s): S_M edges
@@ -138,6 +140,40 @@ TEST(Creases, MendedAfterSmoothingPutSurfaceNodesOnTheLines) {
   EXPECT_LT(with.normal_deviation_mean_deg, without.normal_deviation_mean_deg);
   EXPECT_LE(with.normal_deviation_max_deg, without.normal_deviation_max_deg);
   EXPECT_LE(with.hausdorff, without.hausdorff * 1.01);
+}
+
+// The cap flips on a real fault whose worst tets stand on S_M caps (San Jacinto Claremont east at E/50, where
+// without them a tet of 10-160 degrees sits on an S_M triangle of 9, 10 and 161 degrees; 2-3 s a run): with
+// them the mesh's worst shape against the floors (the smallest angle over 15 degrees, 180 less the largest
+// over 30, the mean ratio over 0.35) and its smallest mean ratio are no worse than without, and the
+// interface stays on S and oriented.
+TEST(Flips, CapFlipsWidenTheTetsOnSurfaceCapsOfARealFault) {
+  const std::optional<TriangleSurface> fault =
+      testing::read_shared_fault("PNRA-SJFZ-SJCV-San_Jacinto_Claremont_fault_east-CFM4_1000m.ts");
+  if (!fault) GTEST_SKIP() << "no shared fault data beside the checkout";
+  const TriangleSurface& surface = *fault;
+  const Box box = testing::box_around(surface);
+  InsertionOptions options;
+  options.resolution = testing::largest_extent(surface) / 50;
+  options.improvement.cap_angle = 180.0;
+  const InsertionResult without = insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
+  options.improvement.cap_angle = InsertionOptions{}.improvement.cap_angle;
+  const InsertionResult with = insert_surfaces(make_cube_meccano(box, 0), {&surface, 1}, options);
+  EXPECT_EQ(without.improvement->flips.cap_flips, 0);
+  EXPECT_GT(with.improvement->flips.cap_flips, 0);
+  ASSERT_TRUE(verify_mesh(with.mesh, {.physical = true}).ok());
+  expect_interface_on_surface(with, {&surface, 1}, box);
+
+  const ShapeFloors floors;
+  auto worst_shape = [&](const TetMesh& mesh) {
+    double worst = 1.0;
+    for (TetId t = 0; t < mesh.num_tets(); ++t)
+      worst = std::min(worst, worst_shape_over_floors(oriented_points(mesh, t), floors));
+    return worst;
+  };
+  EXPECT_LT(worst_shape(without.mesh), 1.0) << "no tet outside the floors: the case no longer tests the flips";
+  EXPECT_GE(worst_shape(with.mesh), worst_shape(without.mesh));
+  EXPECT_GE(with.quality_after_smoothing.equilateral.min, without.quality_after_smoothing.equilateral.min);
 }
 
 // Hundreds of flips (the spherical cap with an irregular S_M at threshold 0.5), the same mesh on 1 and 2

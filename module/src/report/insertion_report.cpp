@@ -101,6 +101,7 @@ void write_improvement(JsonWriter& json, const ImprovementStats& s, double secon
   json.key("flips_2_3").value(s.flips.flips_2_3).key("flips_3_2").value(s.flips.flips_3_2);
   json.key("flips_4_4").value(s.flips.flips_4_4).key("edge_removals").value(s.flips.edge_removals);
   json.key("surface_edge_flips").value(s.flips.surface_edge_flips);
+  json.key("cap_flips").value(s.flips.cap_flips);
   json.key("crease_splits").value(s.flips.crease_splits);
   json.key("crease_moves").value(s.flips.crease_moves);
   json.end_object();

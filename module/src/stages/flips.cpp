@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <stdexcept>
@@ -19,9 +20,10 @@ namespace {
 
 using Tet = std::array<VertexId, 4>;
 constexpr double unacceptable = -std::numeric_limits<double>::infinity();
-// A crease mend may leave a tet this poor (equilateral mean ratio), or as poor as the mesh's worst if that
-// is poorer, for the smoothing after it to lift (doc/benchmarks.md, "Creases").
-constexpr double crease_floor = 0.1;
+// A crease mend or a cap flip may leave a tet this poor (equilateral mean ratio), for the smoothing after
+// it to lift (doc/benchmarks.md, "Creases" and "Cap flips"); a crease mend also as poor as the mesh's worst
+// if that is poorer.
+constexpr double mend_floor = 0.1;
 // Passes of conform_to_creases per surface: each mends crossings that the previous ones made or left.
 constexpr int max_crease_passes = 8;
 
@@ -65,6 +67,7 @@ struct Retriangulation {
   std::optional<SurfaceFlip> surface_flip;
   // A crease split: the apexes x of the S_M triangles (a, b, x) it halves (empty for flips).
   std::vector<VertexId> split_apexes;
+  bool widens_cap = false;  // an edge flip inside S_M that replaces a cap (flip_surface_caps)
 };
 
 class Flipper {
@@ -75,6 +78,7 @@ class Flipper {
         surfaces_(surfaces),
         regions_(regions),
         options_(options),
+        floors_{options.min_dihedral, options.max_dihedral, options.threshold},
         surface_of_(mesh.points.size(), -1),
         projection_of_(mesh.points.size(), -1),
         node_index_(mesh.points.size(), -1) {
@@ -106,10 +110,8 @@ class Flipper {
   FlipStats conform_to_creases() {
     double worst = std::numeric_limits<double>::infinity();
     for (TetId t = 0; t < mesh_.num_tets(); ++t) worst = std::min(worst, quality(mesh_.oriented_tet(t)));
-    mend_floor_ = std::max(std::pow(crease_floor, 3), worst);  // quality() is cubed
-    incident_.assign(mesh_.points.size(), no_tet);
-    for (TetId t = 0; t < mesh_.num_tets(); ++t)
-      for (VertexId v : mesh_.tets[t]) incident_[v] = t;
+    mend_floor_ = std::max(std::pow(mend_floor, 3), worst);  // quality() is cubed
+    index_incident();
     for (int s = 0; s < static_cast<int>(surfaces_.size()); ++s) {
       for (int pass = 0; pass < max_crease_passes; ++pass) {
         const SurfaceProjection& projection = *surfaces_[s];
@@ -131,6 +133,10 @@ class Flipper {
   }
 
   FlipStats run() {
+    const int caps = flip_surface_caps();
+    if (options_.progress)
+      options_.progress("improvement cap flips: " + std::to_string(stats_.cap_flips) + " of " + std::to_string(caps) +
+                        " S_M caps under tets outside the floors");
     std::vector<TetId> candidates(mesh_.tets.size());
     std::iota(candidates.begin(), candidates.end(), TetId{0});
     for (int pass = 1; pass <= options_.max_flip_passes; ++pass) {
@@ -211,6 +217,79 @@ class Flipper {
     if (best) apply(*best);
   }
 
+  // An S_M cap (a triangle (a, b, c) whose angle at c is wider than options_.cap_angle) gives the tets standing
+  // on it a dihedral angle about as wide along the edges from c upwards, and no node move within S mends it:
+  // the guards on S_M's tilt and sag hold c. So each cap with a tet outside the floors around its longest
+  // edge (a, b) has that edge flipped to (c, d), d the apex of S_M's triangle across it (edge_removal),
+  // if the two new S_M triangles' widest angle is narrower than the old ones', S_M stays embedded in P and
+  // no less aligned with S (interface_flip), and no new tet is inverted or poorer than both mend_floor and
+  // the worst tet it replaces. The new tets are then smoothed with the rest of the round's. Returns how
+  // many caps had a tet outside the floors.
+  int flip_surface_caps() {
+    int caps = 0;
+    index_incident();
+    const double floor = std::pow(mend_floor, 3);  // quality() is cubed
+    if (options_.cap_angle >= 180.0) return 0;
+    const double cap_cosine = std::cos(options_.cap_angle * std::numbers::pi / 180.0);
+    for (int s = 0; s < static_cast<int>(surfaces_.size()); ++s) {
+      const SurfaceProjection& projection = *surfaces_[s];
+      for (std::size_t k = 0; k < projection.triangles.size(); ++k) {
+        const std::array<int, 3> triangle = projection.triangles[k];  // a flip below rewrites it
+        const auto [corner, cosine] = widest_corner(s, triangle);
+        if (cosine > cap_cosine) continue;
+        const VertexId a = projection.nodes[triangle[(corner + 1) % 3]],
+                       b = projection.nodes[triangle[(corner + 2) % 3]];
+        const TetId start = tet_holding_edge(s, a, b);
+        const std::vector<TetId> around = tets_around_edge(mesh_, start, a, b);
+        if (std::ranges::none_of(
+                around, [&](TetId t) { return worst_shape_over_floors(oriented_points(mesh_, t), floors_) < 1.0; }))
+          continue;
+        ++caps;
+        std::optional<Retriangulation> flip = edge_removal(start, a, b, floor);
+        if (!flip || !flip->surface_flip) continue;
+        auto widest_cosine = [&](const std::array<std::array<int, 3>, 2>& pair) {
+          return std::min(widest_corner(s, pair[0]).second, widest_corner(s, pair[1]).second);
+        };
+        if (widest_cosine(flip->surface_flip->created) <= widest_cosine(flip->surface_flip->removed)) continue;
+        flip->widens_cap = true;
+        apply(*flip);
+      }
+    }
+    incident_.clear();
+    return caps;
+  }
+
+  // The corner of S_M's triangle (node indices of surface s) with the widest angle, and its cosine.
+  std::pair<int, double> widest_corner(int s, const std::array<int, 3>& triangle) const {
+    const SurfaceProjection& projection = *surfaces_[s];
+    std::pair<int, double> widest{0, 2.0};
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& x = mesh_.points[projection.nodes[triangle[k]]];
+      const Eigen::Vector3d u = mesh_.points[projection.nodes[triangle[(k + 1) % 3]]] - x,
+                            w = mesh_.points[projection.nodes[triangle[(k + 2) % 3]]] - x;
+      const double cosine = u.dot(w) / (u.norm() * w.norm());
+      if (cosine < widest.second) widest = {k, cosine};
+    }
+    return widest;
+  }
+
+  // Points incident_ at a tet holding each vertex, for star_of.
+  void index_incident() {
+    incident_.assign(mesh_.points.size(), no_tet);
+    for (TetId t = 0; t < mesh_.num_tets(); ++t)
+      for (VertexId v : mesh_.tets[t]) incident_[v] = t;
+  }
+
+  // A tet holding surface s's S_M edge (a, b) (found from incident_).
+  TetId tet_holding_edge(int s, VertexId a, VertexId b) const {
+    const std::vector<TetId> around_a = star_of(a);
+    const auto start = std::ranges::find_if(
+        around_a, [&](TetId t) { return std::ranges::find(mesh_.tets[t], b) != mesh_.tets[t].end(); });
+    if (start == around_a.end())
+      throw MeshingError("an S_M edge of surface " + std::to_string(s) + " is not an edge of the mesh");
+    return *start;
+  }
+
   // The tets holding vertex v (found from incident_).
   std::vector<TetId> star_of(VertexId v) const {
     std::vector<TetId> star{incident_[v]};
@@ -233,7 +312,7 @@ class Flipper {
   // best of: moving a onto the crossing, moving b there (a node neither on the rim nor on a line already),
   // or splitting the edge there (the tets around it halved); the new or moved node lies at φ of the
   // crossing, on the crease edges of S. A mend must align the S_M triangles it changes better with S
-  // (their worst alignment), keep S_M embedded in P, and leave no tet inverted or below both crease_floor
+  // (their worst alignment), keep S_M embedded in P, and leave no tet inverted or below both mend_floor
   // and the worst tet it changes. Whether a mend was made.
   bool mend_crossing(int s, const CreaseCrossing& crossing) {
     SurfaceProjection& projection = *surfaces_[s];
@@ -242,13 +321,9 @@ class Flipper {
     if (projection.on_rim[crossing.a] && projection.on_rim[crossing.b]) return false;
     if (!(crossing.s > 1e-9 * line.length() && crossing.s < (1.0 - 1e-9) * line.length())) return false;
     const VertexId a = projection.nodes[crossing.a], b = projection.nodes[crossing.b];
-    const std::vector<TetId> around_a = star_of(a);
-    const auto start = std::ranges::find_if(
-        around_a, [&](TetId t) { return std::ranges::find(mesh_.tets[t], b) != mesh_.tets[t].end(); });
-    if (start == around_a.end())
-      throw MeshingError("an S_M edge of surface " + std::to_string(s) + " is not an edge of the mesh");
+    const TetId start = tet_holding_edge(s, a, b);
 
-    if (std::optional<Retriangulation> flip = edge_removal(*start, a, b, mend_floor_); flip && flip->surface_flip) {
+    if (std::optional<Retriangulation> flip = edge_removal(start, a, b, mend_floor_); flip && flip->surface_flip) {
       bool along = true;
       for (const auto& triangle : flip->surface_flip->created)
         for (int node : triangle)
@@ -284,7 +359,7 @@ class Flipper {
     }
 
     const int vertices = mesh_.num_vertices();
-    std::optional<Retriangulation> split = crease_split(s, crossing, point, *start);
+    std::optional<Retriangulation> split = crease_split(s, crossing, point, start);
     if (split && split->worst_created > best && acceptable(split->worst_created, split->worst_removed) &&
         split_aligns(s, crossing, split->split_apexes) && apply(*split)) {
       add_split_node(s, crossing, split->split_apexes);
@@ -301,7 +376,7 @@ class Flipper {
   }
 
   // Whether a mend whose worst new tet is `created` may replace tets whose worst is `removed`: if it is
-  // valid and not below both `removed` and the floor (crease_floor, or the mesh's worst tet if that is
+  // valid and not below both `removed` and the floor (mend_floor, or the mesh's worst tet if that is
   // poorer): the mesh's worst tet never gets worse.
   bool acceptable(double created, double removed) const {
     return created > 0.0 && created >= std::min(removed, mend_floor_);
@@ -811,6 +886,7 @@ class Flipper {
 
     const auto m = r.removed.size();
     if (!r.split_apexes.empty()) ++stats_.crease_splits;
+    else if (r.widens_cap) ++stats_.cap_flips;
     else if (r.surface_flip) ++stats_.surface_edge_flips;
     else if (m == 2) ++stats_.flips_2_3;
     else if (m == 3 && r.created.size() == 2) ++stats_.flips_3_2;
@@ -876,6 +952,7 @@ class Flipper {
   std::span<SurfaceProjection* const> surfaces_;
   std::span<TetRegion* const> regions_;  // per-tet flags that follow the flips
   const ImprovementOptions& options_;
+  const ShapeFloors floors_;  // the shape passes' floors: a cap is flipped under a tet outside them
   // The surfaces_ are projections: one per S_M, or two for a closed one (stages/projection.hpp), whose
   // nodes on the cut are in both.
   static constexpr int shared_node = -2;
@@ -885,7 +962,7 @@ class Flipper {
   std::map<std::pair<int, VertexId>, int> shared_index_;  // (projection, shared vertex) -> its index there
   // Per surface, S_M's triangles by their sorted node indices (triangle_index).
   std::vector<std::map<std::array<int, 3>, int>> triangle_of_;
-  std::vector<TetId> incident_;  // while mending creases: a tet holding each vertex
+  std::vector<TetId> incident_;  // while mending creases or caps: a tet holding each vertex
   double mend_floor_ = 0.0;      // while mending creases: see acceptable()
   std::vector<TetId> free_;      // slots of removed tets not yet reused
   std::vector<TetId> created_;   // the slots filled by this pass's flips
@@ -896,8 +973,9 @@ class Flipper {
 
 // Every count of FlipStats, for the arithmetic below.
 constexpr std::array flip_counts{&FlipStats::flips_2_3,     &FlipStats::flips_3_2,          &FlipStats::flips_4_4,
-                                 &FlipStats::edge_removals, &FlipStats::surface_edge_flips, &FlipStats::crease_splits,
-                                 &FlipStats::crease_moves,  &FlipStats::tets_removed,       &FlipStats::tets_created};
+                                 &FlipStats::edge_removals, &FlipStats::surface_edge_flips, &FlipStats::cap_flips,
+                                 &FlipStats::crease_splits, &FlipStats::crease_moves,       &FlipStats::tets_removed,
+                                 &FlipStats::tets_created};
 
 FlipStats& FlipStats::operator+=(const FlipStats& other) {
   for (auto count : flip_counts) this->*count += other.*count;
@@ -913,8 +991,8 @@ std::string describe(const FlipStats& flips) {
   return std::to_string(flips.flips_2_3) + " 2-3, " + std::to_string(flips.flips_3_2) + " 3-2, " +
          std::to_string(flips.flips_4_4) + " 4-4 flips, " + std::to_string(flips.edge_removals) +
          " larger edge removals, " + std::to_string(flips.surface_edge_flips) + " edge flips inside S_M, " +
-         std::to_string(flips.crease_moves) + " S_M nodes moved onto creases, " + std::to_string(flips.crease_splits) +
-         " S_M edges split at creases";
+         std::to_string(flips.cap_flips) + " S_M caps flipped, " + std::to_string(flips.crease_moves) +
+         " S_M nodes moved onto creases, " + std::to_string(flips.crease_splits) + " S_M edges split at creases";
 }
 
 FlipStats flip_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,

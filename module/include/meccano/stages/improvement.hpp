@@ -41,6 +41,11 @@
 //          (TetKind::bisectable() is false): the bisection hierarchy ends there, and their paper's measure
 //          is taken against the equilateral tet. Serial, in a fixed order: the result does not depend on
 //          the thread count.
+// Caps     (options.topology) at the start of each round of flips: an S_M triangle with an angle wider
+//          than `cap_angle` under a tet outside the shape passes' floors has its longest edge flipped
+//          (edge removal with the other diagonal forced), if the new S_M triangles' widest angle is
+//          narrower, S_M stays embedded in P and no less aligned with S, and no new tet is inverted or
+//          poorer than both 0.1 and the worst tet it replaces; the round's smoothing then lifts them.
 // Creases  (options.topology) first, before any smoothing pass: S_M edges that a crease of S still crosses
 //          (surface/creases.hpp) are mended, by an edge flip inside S_M along the crease, by moving an end of the
 //          edge onto it, or by splitting the edge there (a new S_M node on the crease, the tets around the
@@ -50,9 +55,10 @@
 //          `smooth` the topology and the bisection hierarchy are untouched.
 // Limits   a tet whose four nodes cannot move and that no flip improves (box corners, nodes of two
 //          surfaces, shapes fixed by S's own triangles) stays as it is; no edge contraction, multi-face
-//          removal or vertex insertion away from creases, and no flips of box faces. The shape passes
-//          cannot widen a tet standing on an S_M triangle of 150°+ whose nodes the guards hold (the worst
-//          left on the faults), and the flips choose by mean ratio alone, so they may narrow an angle.
+//          removal or vertex insertion away from creases, and no flips of box faces. A cap whose flip
+//          would fold S_M in P or tilt it from S stays; a tet over a well-shaped S_M triangle whose free
+//          node cannot rise, and tets on S's rim, are what the faults keep outside the floors. The flips
+//          below the threshold choose by mean ratio alone, so they may narrow an angle.
 #pragma once
 
 #include <meccano/mesh/tet_mesh.hpp>
@@ -81,6 +87,9 @@ struct ImprovementOptions {
   int rounds = 3;           // topology: at most this many rounds of flips, each followed by smoothing
   int max_flip_passes = 4;  // flip passes per round
   int max_ring = 10;        // the most tets around an edge that edge removal considers
+  // topology: S_M triangles with an angle wider than this (degrees) are caps, whose longest edge is
+  // flipped where a tet around it is outside the shape passes' floors. 180: no cap flips.
+  double cap_angle = 120.0;
   std::function<void(const std::string&)> progress;  // a line per smoothing pass and per flip pass, if set
 };
 
@@ -88,11 +97,13 @@ struct FlipStats {
   std::int64_t flips_2_3 = 0, flips_3_2 = 0, flips_4_4 = 0;
   std::int64_t edge_removals = 0;       // rings of 5 or more tets
   std::int64_t surface_edge_flips = 0;  // edge removals inside S_M: two interface triangles flipped
+  std::int64_t cap_flips = 0;           // edge flips inside S_M that replace a cap (flip_surface_caps)
   std::int64_t crease_splits = 0;       // S_M edges split where a crease of S crosses them
   std::int64_t crease_moves = 0;        // S_M nodes moved onto a crease that crossed their edge
   std::int64_t tets_removed = 0, tets_created = 0;
   std::int64_t operations() const {
-    return flips_2_3 + flips_3_2 + flips_4_4 + edge_removals + surface_edge_flips + crease_splits + crease_moves;
+    return flips_2_3 + flips_3_2 + flips_4_4 + edge_removals + surface_edge_flips + cap_flips + crease_splits +
+           crease_moves;
   }
   FlipStats& operator+=(const FlipStats& other);
 };

@@ -164,11 +164,11 @@ struct MoveOptions {
 //      l_r = 1/64 without it, none with it).
 //   3. SUS, if the move left tets inverted (or move.smooth), with move.smoothing_sweeps smoothing sweeps;
 //      then the improvement, as in insert_surfaces. In band mode their band holds the dragged rings.
-// The topology, refinement, tags and V_M are the previous step's; nodes beyond the rings (and SUS's band,
-// when it runs) keep their positions bit for bit. No retry: an interface that moved too far for SUS throws
-// MeshingError, and the caller inserts the surfaces anew (stages/sequence.hpp). Throws InputError if a
-// surface's triangulation differs (a parametric triangle of the moved surface flipped or flat). A surface
-// clipped by the box (surface/box_clipping.hpp) is given clipped, each step: it keeps its triangulation
+// The topology (but for the flips of Improvement::topology), refinement, tags and V_M are the previous
+// step's; nodes beyond the rings (and SUS's band, when it runs) keep their positions bit for bit. No
+// retry: an interface that moved too far for SUS throws MeshingError, and the caller inserts the surfaces
+// anew (stages/sequence.hpp). Throws InputError if a surface's triangulation differs (a parametric
+// triangle of the moved surface flipped or flat). A surface clipped by the box (surface/box_clipping.hpp) is given clipped, each step: it keeps its triangulation
 // while no vertex of S crosses a box plane, and its S_M's rim nodes on the box stay on their planes.
 InsertionResult move_surfaces(const InsertionResult& previous, std::span<const TriangleSurface> surfaces,
                               const InsertionOptions& options, const MoveOptions& move = {});

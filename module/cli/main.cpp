@@ -113,7 +113,9 @@ Options:
                            topology (default): their nodes are optimised again (the worst tet of each
                            star never getting worse) in rounds with 2-3 flips and edge removals (3-2,
                            4-4 and larger rings, and edge flips inside the interface where S allows
-                           them); tets made by a flip leave the bisection hierarchy. smooth: the node
+                           them, also of interface triangles wider than 120 degrees under a tet
+                           outside the --improve-angles floors); tets made by a flip leave the
+                           bisection hierarchy. smooth: the node
                            optimisation alone. none: SUS's mesh as it is
   --improve-threshold Q    the equilateral mean ratio below which a tet is improved (default 0.35;
                            higher costs more time)

@@ -226,10 +226,10 @@ class Flipper {
   // the worst tet it replaces. The new tets are then smoothed with the rest of the round's. Returns how
   // many caps had a tet outside the floors.
   int flip_surface_caps() {
+    if (options_.cap_angle >= 180.0) return 0;
     int caps = 0;
     index_incident();
     const double floor = std::pow(mend_floor, 3);  // quality() is cubed
-    if (options_.cap_angle >= 180.0) return 0;
     const double cap_cosine = std::cos(options_.cap_angle * std::numbers::pi / 180.0);
     for (int s = 0; s < static_cast<int>(surfaces_.size()); ++s) {
       const SurfaceProjection& projection = *surfaces_[s];

@@ -66,6 +66,21 @@ void expect_interface_on_surface(const InsertionResult& result, std::span<const 
   }
 }
 
+// The improvement's statistics after it describe the whole mesh (each round of flips measures only the
+// stars its flips changed).
+void expect_statistics_of_the_mesh(const InsertionResult& result, const ImprovementOptions& options) {
+  const ShapeFloors floors{options.min_dihedral, options.max_dihedral, options.threshold};
+  std::int64_t below = 0, outside = 0;
+  for (TetId t = 0; t < result.mesh.num_tets(); ++t) {
+    const TetPoints p = oriented_points(result.mesh, t);
+    below += mean_ratio_equilateral(p) < options.threshold;
+    outside += worst_shape_over_floors(p, floors) < 1.0;
+  }
+  EXPECT_EQ(result.improvement->tets_below_after, below);
+  EXPECT_EQ(result.improvement->tets_outside_floors_after, outside);
+  EXPECT_NEAR(result.improvement->min_quality_after, result.quality_after_smoothing.equilateral.min, 1e-15);
+}
+
 // Smoothing and flips alternate; the interface stays on S and oriented like it.
 TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
   std::int64_t surface_edge_flips = 0, cap_flips = 0;
@@ -88,6 +103,8 @@ TEST(Flips, ThroughThePipelineKeepTheInterfaceOnSAndOriented) {
     EXPECT_EQ(flipped.improvement->remeshed_tets, std::count_if(flipped.mesh.kinds.begin(), flipped.mesh.kinds.end(),
                                                                 [](TetKind k) { return !k.bisectable(); }));
     expect_interface_on_surface(flipped, c.surfaces, c.box);
+    ASSERT_GT(flipped.improvement->rounds, 0);
+    expect_statistics_of_the_mesh(flipped, options.improvement);
   }
   EXPECT_GT(surface_edge_flips, 0) << "no case flipped an edge inside S_M: that path went untested";
   EXPECT_GT(cap_flips, 0) << "no case flipped an S_M cap: that path went untested";

@@ -107,6 +107,26 @@ TEST(Smoothing, UntanglesAScrambledMeshAndKeepsBoxNodesOnTheirSides) {
       }
 }
 
+// With no sweeps (a moved interface's step when the move inverted nothing) SUS only counts.
+TEST(Smoothing, WithNoSweepsMovesNothingAndCountsTheInvertedTets) {
+  TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 3);
+  const GridPoint upper = mesh.meccano.upper_corner();
+  const auto inner = std::ranges::find_if(mesh.grid, [&](const GridPoint& g) {
+    return std::ranges::all_of(std::array{0, 1, 2}, [&](int axis) { return g[axis] != 0 && g[axis] != upper[axis]; });
+  });
+  ASSERT_NE(inner, mesh.grid.end());
+  mesh.points[static_cast<std::size_t>(inner - mesh.grid.begin())].x() += 1.0;  // out of the box
+  const std::int64_t inverted = count_inverted(mesh);
+  ASSERT_GT(inverted, 0);
+  const std::vector<Eigen::Vector3d> before = mesh.points;
+  const SmoothingStats stats = smooth_mesh(mesh, {}, {.max_sweeps = 0});
+  EXPECT_EQ(mesh.points, before);
+  EXPECT_EQ(stats.inverted_before, inverted);
+  EXPECT_EQ(stats.inverted_after, inverted);
+  EXPECT_FALSE(stats.untangled());
+  EXPECT_TRUE(stats.sweeps.empty());
+}
+
 TEST(Smoothing, ReportsAMeshItCannotUntangle) {
   TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);  // every node is a box corner: all fixed
   mesh.points[0] = {2, 2, 2};                                   // past the opposite corner: every tet turns inside out

@@ -366,7 +366,7 @@ bool untangle_smooth_and_improve(InsertionResult& result, const InsertionOptions
     for (SurfaceProjection& projection : inserted.projections) projections.push_back(&projection);
   untangle_and_smooth(result, projections, options);
   if (!result.smoothing.untangled()) return false;
-  check_stage(result.mesh, "smoothing");
+  if (!result.smoothing.sweeps.empty()) check_stage(result.mesh, "smoothing");  // else it moved nothing
   if (options.improve != Improvement::none) {
     lift_worst_tets(result, projections, options);
     check_stage(result.mesh, "improvement");

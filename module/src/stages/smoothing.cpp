@@ -1216,6 +1216,11 @@ Distortion regularised_distortion(const TetPoints& physical, const Matrix3d& tar
 
 SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
                            const SmoothingOptions& options) {
+  if (options.max_sweeps <= 0) {  // nothing moves: a moved interface's step skips the smoother's set-up
+    SmoothingStats counted;
+    counted.inverted_before = counted.inverted_after = count_inverted(mesh);
+    return counted;
+  }
   return Smoother(mesh, surfaces, options).run();
 }
 

@@ -117,6 +117,7 @@ struct Distortion {
 Distortion regularised_distortion(const TetPoints& physical, const Eigen::Matrix3d& target_inverse, int vertex,
                                   double delta);
 
+// With options.max_sweeps = 0 no node moves and only the inverted tets are counted (the other counts stay 0).
 SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
                            const SmoothingOptions& options = {});
 

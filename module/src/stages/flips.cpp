@@ -728,9 +728,7 @@ class Flipper {
   // 1 where the triangle lies along S.
   double alignment(int s, const std::array<Eigen::Vector3d, 3>& x, const Eigen::Vector2d& at) const {
     const ParametricSurface& surface = *surfaces_[s]->surface;
-    const Eigen::Matrix<double, 3, 2> tangent = surface.derivative(surface.locate(at).triangle);
-    return std::abs(
-        (x[1] - x[0]).cross(x[2] - x[0]).normalized().dot(tangent.col(0).cross(tangent.col(1)).normalized()));
+    return surface.alignment(x, surface.locate(at).triangle);
   }
   // The alignment of S_M's triangle over surface s's nodes, at its centroid in P.
   double triangle_alignment(int s, const std::array<int, 3>& nodes) const {

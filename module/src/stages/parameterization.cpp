@@ -840,4 +840,11 @@ Eigen::Matrix<double, 3, 2> ParametricSurface::derivative(int triangle) const {
   return edges * parametric.inverse();
 }
 
+double ParametricSurface::alignment(const std::array<Eigen::Vector3d, 3>& x, int triangle) const {
+  const Eigen::Matrix<double, 3, 2> tangents = derivative(triangle);
+  const Eigen::Vector3d normal = tangents.col(0).cross(tangents.col(1));
+  const Eigen::Vector3d chord = (x[1] - x[0]).cross(x[2] - x[0]);
+  return std::abs(chord.normalized().dot(normal.normalized()));
+}
+
 }  // namespace meccano

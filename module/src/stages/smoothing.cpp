@@ -861,11 +861,7 @@ ChordStray Smoother::chord_stray(VertexId v, const Placement& at) const {
     }
     const auto location = surface.locate(centroid, at.triangle);
     stray.sag = std::max(stray.sag, ((x[0] + x[1] + x[2]) / 3.0 - surface.evaluate(location)).norm());
-    const Vector3d chord = (x[1] - x[0]).cross(x[2] - x[0]);
-    const Eigen::Matrix<double, 3, 2> tangents = surface.derivative(location.triangle);
-    const Vector3d normal = tangents.col(0).cross(tangents.col(1));
-    const double norms = chord.norm() * normal.norm();
-    if (norms > 0.0) smallest_cosine = std::min(smallest_cosine, std::abs(chord.dot(normal)) / norms);
+    smallest_cosine = std::min(smallest_cosine, surface.alignment(x, location.triangle));
   }
   stray.tilt = std::acos(std::clamp(smallest_cosine, -1.0, 1.0));
   return stray;

@@ -146,6 +146,10 @@ class ParametricSurface {
 
   Eigen::Vector3d evaluate(const Location& location) const;    // φ(uv)
   Eigen::Matrix<double, 3, 2> derivative(int triangle) const;  // dφ/duv, constant per triangle
+  // How closely the triangle with corners x lies along S's triangle `triangle`: |cos| of the angle between
+  // their normals, 1 where they are parallel, 0 for a degenerate triangle (no normal: never aligned). An
+  // S_M triangle's alignment with S is taken at its centroid in P.
+  double alignment(const std::array<Eigen::Vector3d, 3>& x, int triangle) const;
   const SquareParameterization& parameterization() const { return parameterization_; }
   int triangle_count() const { return static_cast<int>(triangles_.size()); }
 

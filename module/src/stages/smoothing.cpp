@@ -760,29 +760,27 @@ bool Smoother::lift_worst_shape(VertexId v) {
     }
     tets.emplace_back(p, local);
   }
-  // Every ratio of the star with v at x, into `out` (the 7 of tets[k] from 7 k); returns the smallest.
+  // The ratios of tets[k] with v at x, into their places in `out` (the 7 of tets[k] from 7 k); returns
+  // the smallest.
   constexpr std::size_t ratios_per_tet = 7;
+  auto evaluate_tet = [&](std::size_t k, const Vector3d& x, std::vector<double>& out) {
+    auto [p, local] = tets[k];
+    p[local] = x;
+    const auto tet_ratios = shape_over_floors(p, floors_);
+    std::copy(tet_ratios.begin(), tet_ratios.end(), out.begin() + static_cast<std::ptrdiff_t>(ratios_per_tet * k));
+    return *std::min_element(tet_ratios.begin(), tet_ratios.end());
+  };
+  // Every ratio of the star with v at x, into `out`; returns the smallest.
   auto evaluate = [&](const Vector3d& x, std::vector<double>& out) {
-    out.clear();
+    out.resize(ratios_per_tet * tets.size());
     double smallest = infinity;
-    for (auto [p, local] : tets) {
-      p[local] = x;
-      for (const double ratio : shape_over_floors(p, floors_)) {
-        out.push_back(ratio);
-        smallest = std::min(smallest, ratio);
-      }
-    }
+    for (std::size_t k = 0; k < tets.size(); ++k) smallest = std::min(smallest, evaluate_tet(k, x, out));
     return smallest;
   };
-  // The ratios of the tets in active_tets alone, into their places in `out` (sized by evaluate): the
-  // gradient probes need the active ratios only, a few tets of the star's 20 to 30.
+  // The ratios of the tets in active_tets alone: the gradient probes need the active ratios only, a few
+  // tets of the star's 20 to 30.
   auto evaluate_active = [&](const Vector3d& x, std::vector<double>& out) {
-    for (const std::size_t k : active_tets) {
-      auto [p, local] = tets[k];
-      p[local] = x;
-      const auto tet_ratios = shape_over_floors(p, floors_);
-      std::copy(tet_ratios.begin(), tet_ratios.end(), out.begin() + static_cast<std::ptrdiff_t>(ratios_per_tet * k));
-    }
+    for (const std::size_t k : active_tets) evaluate_tet(k, x, out);
   };
   constexpr double active_band = 0.02;
   const double difference = 1e-7 * length;
@@ -815,7 +813,7 @@ bool Smoother::lift_worst_shape(VertexId v) {
         active.push_back(i);
         if (active_tets.empty() || active_tets.back() != i / ratios_per_tet) active_tets.push_back(i / ratios_per_tet);
       }
-    trial_ratios.resize(ratios.size());
+    trial_ratios.resize(ratios.size());  // evaluate_active fills only the active tets' places
     gradients.assign(active.size(), Vector3d::Zero());
     for (int k = 0; k < 3; ++k) {
       scale[k] = j.col(k).norm();

@@ -117,7 +117,7 @@ Options:
                            outside the --improve-angles floors); tets made by a flip leave the
                            bisection hierarchy. smooth: the node
                            optimisation alone. none: SUS's mesh as it is
-  --improve-threshold Q    the equilateral mean ratio below which a tet is improved (default 0.35;
+  --improve-threshold Q    the equilateral mean ratio below which a tet is improved (default 0.40;
                            higher costs more time)
   --improve-angles MIN,MAX after the mean ratio, the nodes of tets with a dihedral angle below MIN or
                            above MAX degrees (or a mean ratio below the threshold) raise their star's

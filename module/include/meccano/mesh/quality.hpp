@@ -39,7 +39,7 @@ std::array<double, 6> dihedral_angles_deg(const TetPoints& p);
 // Floors on a tet's shape (issue 18's targets): every dihedral angle within [min_dihedral_deg,
 // max_dihedral_deg] and the equilateral mean ratio at least mean_ratio. 0°, 180° or 0 turn a floor off.
 struct ShapeFloors {
-  double min_dihedral_deg = 15.0, max_dihedral_deg = 150.0, mean_ratio = 0.35;
+  double min_dihedral_deg = 15.0, max_dihedral_deg = 150.0, mean_ratio = 0.40;
   bool angles_off() const { return min_dihedral_deg <= 0.0 && max_dihedral_deg >= 180.0; }
 };
 // A tet's shape as ratios to the floors, 1 where a floor is just met: per dihedral angle θ (edges 01, 02,

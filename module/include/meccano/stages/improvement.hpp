@@ -74,7 +74,7 @@
 namespace meccano {
 
 struct ImprovementOptions {
-  double threshold = 0.35;  // equilateral mean ratio below which a tet is improved
+  double threshold = 0.40;  // equilateral mean ratio below which a tet is improved
   int max_passes = 10;      // smoothing passes per round
   int newton_steps = 8;     // per node and pass
   double power = 8.0;       // p of the star's Σ η^p

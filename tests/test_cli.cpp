@@ -143,6 +143,8 @@ TEST_F(CliTest, UsageErrorsExitTwoWithAMessage) {
        "--improve harder: the modes are topology, smooth and none"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --improve-threshold 0 --output " + path("a.msh"),
        "--improve-threshold must be above 0 and at most 1"},
+      {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --improve-first-threshold 2 --output " + path("a.msh"),
+       "--improve-first-threshold must be at least 0 and at most 1"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --improve-angles 15 --output " + path("a.msh"),
        "--improve-angles takes 2 comma-separated numbers"},
       {"--box 0,0,0,1,1,1 --surface s.obj --resolution 0.1 --improve-angles 75,150 --output " + path("a.msh"),

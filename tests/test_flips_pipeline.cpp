@@ -69,7 +69,7 @@ void expect_interface_on_surface(const InsertionResult& result, std::span<const 
 // The improvement's statistics after it describe the whole mesh (each round of flips measures only the
 // stars its flips changed).
 void expect_statistics_of_the_mesh(const InsertionResult& result, const ImprovementOptions& options) {
-  const ShapeFloors floors{options.min_dihedral, options.max_dihedral, options.threshold};
+  const ShapeFloors floors = options.floors();
   std::int64_t below = 0, outside = 0;
   for (TetId t = 0; t < result.mesh.num_tets(); ++t) {
     const TetPoints p = oriented_points(result.mesh, t);

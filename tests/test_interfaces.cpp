@@ -136,8 +136,9 @@ TEST(SurfaceInterfaces, EveryFaceReferenceNamesTheFaceOfTheOrientedCell) {
       ++references;
     }
   }
-  // Not a vacuous check: in the meccano, about half the tets are negatively ordered.
-  EXPECT_GT(swapped, references / 10);
+  // Not a vacuous check: in the meccano about half the tets are negatively ordered (the tets the improvement
+  // remeshes are stored positively: here about a tenth of the references stay swapped).
+  EXPECT_GT(swapped, references / 20);
 }
 
 TEST(SurfaceInterfaces, NoneBeforeTheApproximationStage) {

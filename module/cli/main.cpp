@@ -119,6 +119,9 @@ Options:
                            optimisation alone. none: SUS's mesh as it is
   --improve-threshold Q    the equilateral mean ratio below which a tet is improved (default 0.40;
                            higher costs more time)
+  --improve-first-threshold Q
+                           when below --improve-threshold, the improvement runs first at Q, then at
+                           --improve-threshold: the worst tets are lifted first (default 0.35; 0: once)
   --improve-angles MIN,MAX after the mean ratio, the nodes of tets with a dihedral angle below MIN or
                            above MAX degrees (or a mean ratio below the threshold) raise their star's
                            worst shape against these floors (default 15,150; 0,180: no shape passes)
@@ -237,6 +240,7 @@ struct Options {
   meccano::SmoothingOptions smoothing;
   meccano::Improvement improve = meccano::InsertionOptions{}.improve;
   double improve_threshold = meccano::ImprovementOptions{}.threshold;
+  double improve_first_threshold = meccano::ImprovementOptions{}.first_threshold;
   std::array<double, 2> improve_angles{meccano::ImprovementOptions{}.min_dihedral,
                                        meccano::ImprovementOptions{}.max_dihedral};
   std::optional<int> threads;
@@ -349,6 +353,11 @@ void declare_method_options(ArgumentParser& parser, Options& options) {
     options.improve_threshold = meccano::tools::parse_numbers("--improve-threshold", text, 1)[0];
     if (!(options.improve_threshold > 0.0 && options.improve_threshold <= 1.0))
       throw UsageError("--improve-threshold must be above 0 and at most 1");
+  });
+  parser.value({"--improve-first-threshold"}, [&](const std::string& text) {
+    options.improve_first_threshold = meccano::tools::parse_numbers("--improve-first-threshold", text, 1)[0];
+    if (!(options.improve_first_threshold >= 0.0 && options.improve_first_threshold <= 1.0))
+      throw UsageError("--improve-first-threshold must be at least 0 and at most 1");
   });
   parser.value({"--improve-angles"}, [&](const std::string& text) {
     const auto angles = meccano::tools::parse_numbers("--improve-angles", text, 2);
@@ -509,6 +518,7 @@ meccano::InsertionOptions insertion_options(const Options& options) {
   insertion.drag_rings = options.drag_rings;
   insertion.improve = options.improve;
   insertion.improvement.threshold = options.improve_threshold;
+  insertion.improvement.first_threshold = options.improve_first_threshold;
   insertion.improvement.min_dihedral = options.improve_angles[0];
   insertion.improvement.max_dihedral = options.improve_angles[1];
   insertion.max_tets = options.max_tets;

@@ -78,7 +78,7 @@ class Flipper {
         surfaces_(surfaces),
         regions_(regions),
         options_(options),
-        floors_{options.min_dihedral, options.max_dihedral, options.threshold},
+        floors_{options.floors()},
         surface_of_(mesh.points.size(), -1),
         projection_of_(mesh.points.size(), -1),
         node_index_(mesh.points.size(), -1) {

@@ -138,7 +138,10 @@ void report_smoothing(const InsertionOptions& options, const SmoothingStats& smo
 
 void report_improvement(const InsertionOptions& options, const ImprovementOptions& improvement,
                         const ImprovementStats& improved) {
-  report(options, "improvement: ", improved.passes, " passes over the tets below ", improvement.threshold, " (",
+  std::ostringstream thresholds;
+  if (improvement.lowest_threshold() < improvement.threshold) thresholds << improvement.first_threshold << ", then ";
+  thresholds << improvement.threshold;
+  report(options, "improvement: ", improved.passes, " passes over the tets below ", thresholds.str(), " (",
          improved.tets_below_before, " before, ", improved.tets_below_after, " after), ", improved.nodes_moved, " of ",
          improved.node_updates, " node updates moved",
          improvement.topology ? "; " + std::to_string(improved.rounds) + " rounds of flips: " + describe(improved.flips)

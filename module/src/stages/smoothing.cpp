@@ -1059,7 +1059,7 @@ SmoothingStats Smoother::run() {
 
 ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<const std::uint8_t> only) {
   improving_ = &options;
-  floors_ = {options.min_dihedral, options.max_dihedral, options.threshold};
+  floors_ = options.floors();
   tangled_ = false;
   aim_at(SmoothingTarget::meccano);
   guard_inverses_ = std::move(target_inverses_);
@@ -1200,9 +1200,13 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
 }
 
 // The mesh's tets below options.threshold, its smallest equilateral mean ratio and, if the shape passes
-// ran, its tets outside their floors, into stats' "after" fields.
-void count_after_improvement(const TetMesh& mesh, const ImprovementOptions& options, ImprovementStats& stats) {
-  const ShapeFloors floors{options.min_dihedral, options.max_dihedral, options.threshold};
+// run, its tets outside their floors.
+struct QualityCounts {
+  std::int64_t below = 0, outside = 0;
+  double smallest = 0.0;
+};
+QualityCounts count_quality(const TetMesh& mesh, const ImprovementOptions& options) {
+  const ShapeFloors floors = options.floors();
   std::int64_t below = 0, outside = 0;
   double smallest = infinity;
 #pragma omp parallel for schedule(static) reduction(+ : below, outside) reduction(min : smallest)
@@ -1213,9 +1217,15 @@ void count_after_improvement(const TetMesh& mesh, const ImprovementOptions& opti
     smallest = std::min(smallest, q);
     if (!floors.angles_off()) outside += worst_shape_over_floors(p, floors) < 1.0;
   }
-  stats.tets_below_after = below;
-  stats.min_quality_after = mesh.tets.empty() ? 0.0 : smallest;
-  if (!floors.angles_off()) stats.tets_outside_floors_after = outside;
+  return {below, outside, mesh.tets.empty() ? 0.0 : smallest};
+}
+
+// count_quality into stats' "after" fields.
+void count_after_improvement(const TetMesh& mesh, const ImprovementOptions& options, ImprovementStats& stats) {
+  const QualityCounts counts = count_quality(mesh, options);
+  stats.tets_below_after = counts.below;
+  stats.min_quality_after = counts.smallest;
+  if (!options.floors().angles_off()) stats.tets_outside_floors_after = counts.outside;
 }
 
 }  // namespace
@@ -1239,6 +1249,28 @@ SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> su
 ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
                                     const ImprovementOptions& options, const SmoothingOptions& sus,
                                     std::span<TetRegion* const> regions) {
+  if (options.first_threshold > 0.0 && options.first_threshold < options.threshold) {
+    // The worst tets first: the whole stage at first_threshold, then at threshold. The counts before are
+    // the mesh's against the final threshold and floors; the work is that of both stages.
+    const QualityCounts before = count_quality(mesh, options);
+    ImprovementOptions first = options, then = options;
+    first.threshold = options.first_threshold;
+    first.first_threshold = then.first_threshold = 0.0;
+    const ImprovementStats lifted = improve_worst_tets(mesh, surfaces, first, sus, regions);
+    ImprovementStats stats = improve_worst_tets(mesh, surfaces, then, sus, regions);
+    stats.tets_below_before = before.below;
+    stats.min_quality_before = before.smallest;
+    stats.tets_outside_floors_before = before.outside;
+    stats.passes += lifted.passes;
+    stats.rounds += lifted.rounds;
+    stats.node_updates += lifted.node_updates;
+    stats.nodes_moved += lifted.nodes_moved;
+    stats.shape_passes += lifted.shape_passes;
+    stats.shape_node_updates += lifted.shape_node_updates;
+    stats.shape_nodes_moved += lifted.shape_nodes_moved;
+    stats.flips += lifted.flips;
+    return stats;
+  }
   // improve() sets both targets; SUS's mode and band decide which nodes are free. A flip changes the
   // stars, so each round smooths with a Smoother built afresh.
   auto smooth = [&](std::span<const std::uint8_t> only) {

@@ -14,8 +14,9 @@
 //          tet of a star never gets worse) and keeps its smallest mean ratio against the meccano
 //          counterparts (the paper's measure) where it is below `threshold`, or at least `threshold`
 //          where it is above. So the mesh's equilateral minimum cannot fall, nor its meccano minimum
-//          below min(before, threshold). Nodes move with the freedom SUS gives them (box nodes in their planes,
-//          S_M nodes on S, rim nodes along the rim, crease nodes along the crease, S_M kept embedded).
+//          below min(before, threshold) (lowest_threshold() with the ladder below). Nodes move with the
+//          freedom SUS gives them (box nodes in their planes, S_M nodes on S, rim nodes along the rim,
+//          crease nodes along the crease, S_M kept embedded).
 //          Nodes are coloured as in SUS, so the result does not depend on the thread count. In band mode
 //          only the band's nodes move, as in SUS.
 // Shapes   (min_dihedral > 0 or max_dihedral < 180) after those passes, in each round: Σ η^p hardly sees a
@@ -51,6 +52,11 @@
 //          edge onto it, or by splitting the edge there (a new S_M node on the crease, the tets around the
 //          edge halved), when that aligns S_M's triangles there better with S and leaves no tet below both
 //          what it replaces and max(0.1, the mesh's worst): conform_to_creases.
+// Ladder   (first_threshold in (0, threshold)) the whole stage runs at first_threshold, then at threshold:
+//          every pass, flip and guard above is local and max-min, so where it ends depends on its path. With
+//          the higher threshold alone the many tets between the two take moves around the worst tets
+//          before they are lifted, and can leave them stuck (benchmarks.md, "The threshold raised to 0.40,
+//          the worst tets first").
 // Output   the improved mesh, still valid and conforming, its S_M nodes still on S; statistics. With
 //          `smooth` the topology and the bisection hierarchy are untouched.
 // Limits   a tet whose four nodes cannot move and that no flip improves (box corners, nodes of two
@@ -61,11 +67,13 @@
 //          below the threshold choose by mean ratio alone, so they may narrow an angle.
 #pragma once
 
+#include <meccano/mesh/quality.hpp>
 #include <meccano/mesh/tet_mesh.hpp>
 #include <meccano/stages/projection.hpp>
 #include <meccano/stages/smoothing.hpp>
 #include <meccano/stages/volumetric_approximation.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -75,9 +83,13 @@ namespace meccano {
 
 struct ImprovementOptions {
   double threshold = 0.40;  // equilateral mean ratio below which a tet is improved
-  int max_passes = 10;      // smoothing passes per round
-  int newton_steps = 8;     // per node and pass
-  double power = 8.0;       // p of the star's Σ η^p
+  // When below `threshold`, the whole stage runs first with this threshold, then with `threshold`: the
+  // worst tets are lifted before the many between the two take the passes' and flips' moves (a single
+  // stage at 0.40 left a surface's worst tet at 0.25, where one at 0.35 first reached 0.40). 0: one stage.
+  double first_threshold = 0.35;
+  int max_passes = 10;   // smoothing passes per round
+  int newton_steps = 8;  // per node and pass
+  double power = 8.0;    // p of the star's Σ η^p
   // Shape passes after the Newton passes: the nodes of tets with a dihedral angle below min_dihedral or
   // above max_dihedral (degrees), or a mean ratio below `threshold`, raise their star's worst shape
   // against these floors (max-min). 0 and 180: no shape passes.
@@ -91,6 +103,10 @@ struct ImprovementOptions {
   // flipped where a tet around it is outside the shape passes' floors. 180: no cap flips.
   double cap_angle = 120.0;
   std::function<void(const std::string&)> progress;  // a line per smoothing pass and per flip pass, if set
+  // The paper's measure is kept at least min(its minimum before, this): each stage's own threshold.
+  double lowest_threshold() const { return first_threshold > 0.0 ? std::min(first_threshold, threshold) : threshold; }
+  // What the shape passes aim at: the dihedral floors and `threshold`.
+  ShapeFloors floors() const { return {min_dihedral, max_dihedral, threshold}; }
 };
 
 struct FlipStats {

@@ -1220,6 +1220,16 @@ QualityCounts count_quality(const TetMesh& mesh, const ImprovementOptions& optio
   return {below, outside, mesh.tets.empty() ? 0.0 : smallest};
 }
 
+// The passes and node updates of `more` (Newton and shape passes) added to `stats`.
+void add_smoothing_work(ImprovementStats& stats, const ImprovementStats& more) {
+  stats.passes += more.passes;
+  stats.node_updates += more.node_updates;
+  stats.nodes_moved += more.nodes_moved;
+  stats.shape_passes += more.shape_passes;
+  stats.shape_node_updates += more.shape_node_updates;
+  stats.shape_nodes_moved += more.shape_nodes_moved;
+}
+
 // count_quality into stats' "after" fields.
 void count_after_improvement(const TetMesh& mesh, const ImprovementOptions& options, ImprovementStats& stats) {
   const QualityCounts counts = count_quality(mesh, options);
@@ -1261,13 +1271,8 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
     stats.tets_below_before = before.below;
     stats.min_quality_before = before.smallest;
     stats.tets_outside_floors_before = before.outside;
-    stats.passes += lifted.passes;
+    add_smoothing_work(stats, lifted);
     stats.rounds += lifted.rounds;
-    stats.node_updates += lifted.node_updates;
-    stats.nodes_moved += lifted.nodes_moved;
-    stats.shape_passes += lifted.shape_passes;
-    stats.shape_node_updates += lifted.shape_node_updates;
-    stats.shape_nodes_moved += lifted.shape_nodes_moved;
     stats.flips += lifted.flips;
     return stats;
   }
@@ -1294,13 +1299,7 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
     for (TetId t = 0; t < mesh.num_tets(); ++t)
       if (!mesh.bisectable(t))
         for (VertexId v : mesh.tets[t]) flipped[v] = 1;
-    const ImprovementStats smoothed = smooth(flipped);
-    stats.passes += smoothed.passes;
-    stats.node_updates += smoothed.node_updates;
-    stats.nodes_moved += smoothed.nodes_moved;
-    stats.shape_passes += smoothed.shape_passes;
-    stats.shape_node_updates += smoothed.shape_node_updates;
-    stats.shape_nodes_moved += smoothed.shape_nodes_moved;
+    add_smoothing_work(stats, smooth(flipped));
   }
   // A round's smoothing measured only the stars it could change: the mesh's counts after the last round.
   if (stats.rounds > 0) count_after_improvement(mesh, options, stats);

@@ -1259,7 +1259,7 @@ SmoothingStats smooth_mesh(TetMesh& mesh, std::span<SurfaceProjection* const> su
 ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
                                     const ImprovementOptions& options, const SmoothingOptions& sus,
                                     std::span<TetRegion* const> regions) {
-  if (options.first_threshold > 0.0 && options.first_threshold < options.threshold) {
+  if (options.lowest_threshold() < options.threshold) {
     // The worst tets first: the whole stage at first_threshold, then at threshold. The counts before are
     // the mesh's against the final threshold and floors; the work is that of both stages.
     const QualityCounts before = count_quality(mesh, options);

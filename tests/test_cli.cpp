@@ -378,6 +378,24 @@ TEST_F(CliTest, FullPipelineWritesAnUntangledMeshAReportAndHistograms) {
                     "after_smoothing_equilateral");
 }
 
+// The report says what the improvement aimed at: the thresholds given (the ladder's first stage and the
+// last) and the dihedral floors, inside its "improvement" object.
+TEST_F(CliTest, ReportRecordsTheImprovementsThresholdsAndFloors) {
+  const std::string file = write_obj("patch.obj", testing::paper_like_patch(12));
+  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + file + " --resolution 0.07 --threads 2 --quiet " +
+                             "--improve-threshold 0.42 --improve-first-threshold 0.3 --output " + path("mesh.msh") +
+                             " --report " + path("report.json"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  std::ifstream report_file(path("report.json"));
+  const std::string report((std::istreambuf_iterator<char>(report_file)), std::istreambuf_iterator<char>());
+  const std::size_t improvement = report.find("\"improvement\": {");
+  ASSERT_NE(improvement, std::string::npos) << report;
+  const std::string stage = report.substr(improvement, report.find('}', improvement) - improvement);
+  for (const char* entry :
+       {"\"threshold\": 0.42,", "\"first_threshold\": 0.3,", "\"min_dihedral_deg\": 15,", "\"max_dihedral_deg\": 150,"})
+    EXPECT_NE(stage.find(entry), std::string::npos) << entry << " missing from\n" << stage;
+}
+
 // The node tags and coordinates of an MSH file, and its views' data by view name and node tag.
 struct MshNodes {
   std::map<std::size_t, Eigen::Vector3d> points;

@@ -140,6 +140,11 @@ TEST(Improvement, ALadderIsTheStageAtTheFirstThresholdThenAtTheThreshold) {
   EXPECT_EQ(ladder.min_quality_before, smallest);
   EXPECT_EQ(ladder.tets_below_after, finished.tets_below_after);
   EXPECT_EQ(ladder.min_quality_after, finished.min_quality_after);
+  EXPECT_EQ(ladder.floors.mean_ratio, options.threshold);
+  EXPECT_EQ(ladder.first_threshold, options.first_threshold);
+  EXPECT_EQ(ladder.floors.min_dihedral_deg, options.min_dihedral);
+  EXPECT_EQ(ladder.floors.max_dihedral_deg, options.max_dihedral);
+  EXPECT_EQ(finished.first_threshold, 0.0) << "one stage";
 }
 
 // Through the pipeline: the improvement runs by default, keeps the interface on S and never leaves the

@@ -86,6 +86,11 @@ void write_smoothing(JsonWriter& json, const SmoothingStats& s, double seconds) 
 
 void write_improvement(JsonWriter& json, const ImprovementStats& s, double seconds) {
   json.key("improvement").begin_object();
+  json.key("threshold").value(s.floors.mean_ratio).key("first_threshold").value(s.first_threshold);
+  json.key("min_dihedral_deg")
+      .value(s.floors.min_dihedral_deg)
+      .key("max_dihedral_deg")
+      .value(s.floors.max_dihedral_deg);
   json.key("passes").value(s.passes);
   json.key("tets_below_threshold_before").value(s.tets_below_before);
   json.key("tets_below_threshold_after").value(s.tets_below_after);

@@ -1271,6 +1271,7 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
     stats.tets_below_before = before.below;
     stats.min_quality_before = before.smallest;
     stats.tets_outside_floors_before = before.outside;
+    stats.first_threshold = first.threshold;
     add_smoothing_work(stats, lifted);
     stats.rounds += lifted.rounds;
     stats.flips += lifted.flips;
@@ -1286,6 +1287,7 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
   const FlipStats mends = options.topology ? conform_to_creases(mesh, surfaces, regions, options) : FlipStats{};
   if (options.topology && options.progress) options.progress("improvement creases: " + describe(mends));
   ImprovementStats stats = smooth({});
+  stats.floors = options.floors();
   stats.flips += mends;
   if (!options.topology) return stats;
   for (int round = 0; round < options.rounds; ++round) {

@@ -128,6 +128,10 @@ std::string describe(const FlipStats& flips);  // "N 2-3, N 3-2, N 4-4 flips, N 
 
 
 struct ImprovementStats {
+  // What the stage aimed at: its floors (floors.mean_ratio is the threshold) and, with the ladder, the
+  // first stage's threshold (0: one stage).
+  ShapeFloors floors;
+  double first_threshold = 0.0;
   int passes = 0;                                            // smoothing passes, over all rounds
   int rounds = 0;                                            // topology: rounds with at least one flip
   std::int64_t tets_below_before = 0, tets_below_after = 0;  // tets under the threshold

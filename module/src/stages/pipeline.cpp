@@ -138,9 +138,9 @@ void report_smoothing(const InsertionOptions& options, const SmoothingStats& smo
 
 void report_improvement(const InsertionOptions& options, const ImprovementOptions& improvement,
                         const ImprovementStats& improved) {
-  std::ostringstream thresholds;
-  if (improvement.lowest_threshold() < improvement.threshold) thresholds << improvement.first_threshold << ", then ";
-  thresholds << improvement.threshold;
+  std::ostringstream thresholds;  // what the stage ran at, as its statistics record it (and the report writes)
+  if (improved.first_threshold > 0.0) thresholds << improved.first_threshold << ", then ";
+  thresholds << improved.floors.mean_ratio;
   report(options, "improvement: ", improved.passes, " passes over the tets below ", thresholds.str(), " (",
          improved.tets_below_before, " before, ", improved.tets_below_after, " after), ", improved.nodes_moved, " of ",
          improved.node_updates, " node updates moved",

@@ -4,8 +4,10 @@
 
 #include "geometry/compensated_sum.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 namespace meccano {
@@ -88,39 +90,24 @@ class Checker {
     return cross < 0 ? -cross : cross;
   }
 
+  // Each tet face against its recorded neighbour, without sorting the 4n faces (a sort took 15 % of a
+  // moved interface's step): a face with a neighbour must be that tet's face too, in the opposite
+  // orientation, and the neighbour must point back; a face without one lies on a box side. With every
+  // tet positively oriented (check_tets), the faces then cancel in pairs except the box sides', which
+  // they tile exactly: the tets cover the box once, so no face can belong to three tets either.
   void check_faces() {
-    const auto faces = sorted_face_records(mesh_.tets);
     std::array<int128, 6> side_area{};
-    for (std::size_t i = 0; i < faces.size();) {
-      std::size_t j = i + 1;
-      while (j < faces.size() && faces[j].key == faces[i].key) ++j;
-      const FaceRecord& f = faces[i];
-      const FaceTag tag = mesh_.face_tags[f.tet][f.local_face];
-      if (j - i > 2) {
-        problem("face (", f.key[0], ", ", f.key[1], ", ", f.key[2], ") is shared by ", j - i, " tets");
-      } else if (j - i == 2) {
-        ++report_.interior_faces;
-        const FaceRecord& g = faces[i + 1];
-        if (mesh_.neighbours[f.tet][f.local_face] != g.tet || mesh_.neighbours[g.tet][g.local_face] != f.tet)
-          problem("tets ", f.tet, " and ", g.tet, " share a face but are not recorded as neighbours");
-        if (is_box_side_tag(tag)) problem("interior face of tet ", f.tet, " carries a box-side tag");
-        if (tag != mesh_.face_tags[g.tet][g.local_face])
-          problem("interior face between tets ", f.tet, " and ", g.tet, " is tagged differently on each side");
-      } else {
-        ++report_.boundary_faces;
-        const int side = box_side_of(f.key);
-        if (mesh_.neighbours[f.tet][f.local_face] != no_tet)
-          problem("tet ", f.tet, " face ", f.local_face, " is unshared but has a neighbour");
-        if (side < 0) {
-          problem("tet ", f.tet, " face ", f.local_face, " is unshared but not on the box boundary (a hole)");
-        } else {
-          side_area[side] += twice_area_on_plane(f.key, side / 2);
-          if (tag != box_side_tag(static_cast<BoxSide>(side)))
-            problem("boundary face of tet ", f.tet, " is not tagged ", box_side_name(static_cast<BoxSide>(side)));
+    for (TetId t = 0; t < mesh_.num_tets(); ++t)
+      for (int f = 0; f < 4; ++f) {
+        const TetId n = mesh_.neighbours[t][f];
+        if (n == no_tet) {
+          check_boundary_face(t, f, side_area);
+        } else if (n < 0 || n >= mesh_.num_tets() || n == t) {
+          problem("tet ", t, " face ", f, " has neighbour ", n, ", not another tet");
+        } else if (t < n || !points_back(t, f, n)) {
+          check_interior_face(t, f, n);  // once per pair, and wherever n does not point back
         }
       }
-      i = j;
-    }
     const auto& cells = mesh_.meccano.cells;
     for (int side = 0; side < 6; ++side) {
       const int axis = side / 2;
@@ -128,6 +115,58 @@ class Checker {
       if (side_area[side] != expected)
         problem("boundary faces do not tile box side ", box_side_name(static_cast<BoxSide>(side)));
     }
+  }
+
+  // The local face of tet n with the vertices of tet t's face f, if it has one.
+  std::optional<int> matching_face(TetId t, int f, TetId n) const {
+    std::array<VertexId, 3> face{};
+    for (int k = 0; k < 3; ++k) face[k] = mesh_.tets[t][face_vertices[f][k]];
+    int outside = -1, count = 0;
+    for (int g = 0; g < 4; ++g)
+      if (std::find(face.begin(), face.end(), mesh_.tets[n][g]) == face.end()) {
+        outside = g;
+        ++count;
+      }
+    return count == 1 ? std::optional<int>(outside) : std::nullopt;
+  }
+
+  bool points_back(TetId t, int f, TetId n) const {
+    const std::optional<int> g = matching_face(t, f, n);
+    return g && mesh_.neighbours[n][*g] == t;
+  }
+
+  void check_interior_face(TetId t, int f, TetId n) {
+    const std::optional<int> g = matching_face(t, f, n);
+    if (!g) {
+      problem("tet ", t, " face ", f, " records tet ", n, " as its neighbour, which does not hold that face");
+      return;
+    }
+    if (mesh_.neighbours[n][*g] != t) {
+      problem("tets ", t, " and ", n, " share a face but are not recorded as each other's neighbours");
+      return;
+    }
+    ++report_.interior_faces;
+    const std::array<VertexId, 3> a = mesh_.outward_face(t, f), b = mesh_.outward_face(n, *g);
+    const auto at = static_cast<int>(std::find(b.begin(), b.end(), a[0]) - b.begin());
+    if (b[(at + 1) % 3] != a[2]) problem("tets ", t, " and ", n, " lie on the same side of their shared face");
+    const FaceTag tag = mesh_.face_tags[t][f];
+    if (is_box_side_tag(tag)) problem("interior face of tet ", t, " carries a box-side tag");
+    if (tag != mesh_.face_tags[n][*g])
+      problem("interior face between tets ", t, " and ", n, " is tagged differently on each side");
+  }
+
+  void check_boundary_face(TetId t, int f, std::array<int128, 6>& side_area) {
+    ++report_.boundary_faces;
+    std::array<VertexId, 3> face{};
+    for (int k = 0; k < 3; ++k) face[k] = mesh_.tets[t][face_vertices[f][k]];
+    const int side = box_side_of(face);
+    if (side < 0) {
+      problem("tet ", t, " face ", f, " has no neighbour but is not on the box boundary (a hole)");
+      return;
+    }
+    side_area[side] += twice_area_on_plane(face, side / 2);
+    if (mesh_.face_tags[t][f] != box_side_tag(static_cast<BoxSide>(side)))
+      problem("boundary face of tet ", t, " is not tagged ", box_side_name(static_cast<BoxSide>(side)));
   }
 
   void check_volume() {

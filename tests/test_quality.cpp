@@ -168,6 +168,26 @@ TEST(ShapeOverFloors, MeasureEachAngleAndTheMeanRatioAgainstTheirFloors) {
   EXPECT_LE(worst_shape_over_floors(flat, floors), 0.0);
 }
 
+// worst_shape_over_floors takes two arc cosines where shape_over_floors takes six: the same value, to the
+// bit, on well-shaped tets, slivers, needles and caps, with either angle floor off.
+TEST(ShapeOverFloors, TheWorstRatioIsExactlyTheSmallestOfTheSeven) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0), squash(1e-6, 1.0);
+  for (const ShapeFloors& floors : {ShapeFloors{}, ShapeFloors{20.0, 180.0, 0.3}, ShapeFloors{0.0, 140.0, 0.0}}) {
+    for (int trial = 0; trial < 2000; ++trial) {
+      TetPoints p;
+      for (auto& x : p) x = {coordinate(rng), coordinate(rng), coordinate(rng)};
+      const int flattened = trial % 4;  // 0: as drawn; else one coordinate (or vertex) squashed
+      if (flattened == 1) p[3].z() = p[0].z() + squash(rng) * (p[3].z() - p[0].z());
+      if (flattened == 2) p[1] = p[0] + squash(rng) * (p[1] - p[0]);
+      if (flattened == 3)
+        for (auto& x : p) x.y() *= squash(rng);
+      const auto ratios = shape_over_floors(p, floors);
+      EXPECT_EQ(worst_shape_over_floors(p, floors), *std::min_element(ratios.begin(), ratios.end())) << trial;
+    }
+  }
+}
+
 TEST(QualitySummary, UntouchedCubeHasMeccanoQualityOneAndKuhnClassValues) {
   std::array<int, 3> rounded{};
   for (int c = 0; c < 3; ++c) rounded[c] = static_cast<int>(std::lround(kuhn_class_quality[c] * 1000));

@@ -45,20 +45,20 @@ constexpr double uv_collapse_floor = 0.01;
 //   ∇f = f a,  a = ∇N / N - (2/3) ∇σ / r,
 //   ∇²f = f (a aᵀ + 2|b|²/N I - ∇N ∇Nᵀ / N² + (2/3) σ / r³ ∇σ ∇σᵀ).
 
-// The smallest equilateral and meccano mean ratios (mesh/quality.hpp) over `tets`, +∞ if there is none.
+// The smallest of `measure` (a tet's mean ratio, mesh/quality.hpp) over `tets`, +∞ if there is none.
+template <class Measure>
+double smallest_over(std::span<const TetId> tets, const Measure& measure) {
+  double smallest = infinity;
+  const auto count = static_cast<std::int64_t>(tets.size());
+#pragma omp parallel for schedule(static) reduction(min : smallest)
+  for (std::int64_t i = 0; i < count; ++i) smallest = std::min(smallest, measure(tets[i]));
+  return smallest;
+}
+
+// The smallest equilateral and meccano mean ratios over some tets.
 struct MeanRatioMinima {
   double equilateral = 0.0, meccano = 0.0;
 };
-MeanRatioMinima smallest_mean_ratios(const TetMesh& mesh, std::span<const TetId> tets) {
-  double equilateral = infinity, meccano = infinity;
-  const auto count = static_cast<std::int64_t>(tets.size());
-#pragma omp parallel for schedule(static) reduction(min : equilateral, meccano)
-  for (std::int64_t i = 0; i < count; ++i) {
-    equilateral = std::min(equilateral, mean_ratio_equilateral(oriented_points(mesh, tets[i])));
-    meccano = std::min(meccano, mean_ratio_meccano(mesh, tets[i]));
-  }
-  return {equilateral, meccano};
-}
 
 Matrix3d edge_matrix(const std::array<Vector3d, 4>& p) {
   Matrix3d a;
@@ -253,16 +253,22 @@ class Smoother {
       for (int k = 0; k < 3; ++k)
         for (int axis = 0; axis < 3; ++axis) edges[3 * k + axis] = mesh_.grid[v[k + 1]][axis] - mesh_.grid[v[0]][axis];
       const auto [shape, added] = shape_index.try_emplace(edges, static_cast<std::uint32_t>(target_inverses_.size()));
-      if (added) {
-        Matrix3d w;
-        for (int k = 0; k < 3; ++k)
-          for (int axis = 0; axis < 3; ++axis)
-            w(axis, k) = mesh_.meccano.cell_size[axis] * static_cast<double>(edges[3 * k + axis]) /
-                         static_cast<double>(grid_cell);
-        target_inverses_.push_back(w.inverse());
-      }
+      if (added) target_inverses_.push_back(meccano_target_inverse(t));
       target_of_tet_[t] = shape->second;
     }
+  }
+  // W^-1 of tet t's meccano counterpart (its computational tet), or of the equilateral tet for a
+  // remeshed one.
+  Matrix3d meccano_target_inverse(TetId t) const {
+    if (!mesh_.bisectable(t)) return equilateral_target().inverse();
+    const auto& v = oriented_[t];
+    Matrix3d w;
+    for (int k = 0; k < 3; ++k)
+      for (int axis = 0; axis < 3; ++axis)
+        w(axis, k) = mesh_.meccano.cell_size[axis] *
+                     static_cast<double>(mesh_.grid[v[k + 1]][axis] - mesh_.grid[v[0]][axis]) /
+                     static_cast<double>(grid_cell);
+    return w.inverse();
   }
   const Matrix3d& target_inverse(TetId t) const { return target_inverses_[target_of_tet_[t]]; }
 
@@ -349,11 +355,9 @@ class Smoother {
   static constexpr double initial_untangling_epsilon = 1e-3;
   double untangling_epsilon_ = initial_untangling_epsilon;  // ε / mean|σ|, raised while untangling stalls
   const ImprovementOptions* improving_ = nullptr;           // set while improve() runs
-  std::vector<Matrix3d> guard_inverses_;                    // improving: the meccano target's W^-1, per shape
   ShapeFloors floors_;                                      // improving: what the shape passes aim at
   double shape_mean_ratio_floor_ = 0.0;                     // shape passes: no tet's η / threshold below it
   double shape_meccano_floor_ = 0.0;                        // shape passes: nor its meccano η below it
-  std::vector<std::uint32_t> guard_of_tet_;
 };
 
 void Smoother::classify_nodes() {
@@ -479,8 +483,8 @@ Smoother::Star Smoother::take_star(VertexId v) const {
     }
     const Matrix3d a = physical_edges(t);
     tets.push_back(star_tet(a * target_inverse(t), target_inverse(t), local));
-    if (improving_) {
-      const Matrix3d& meccano = guard_inverses_[guard_of_tet_[t]];
+    if (improving_) {  // computed here: a table per shape (aim_at) costs a pass over every tet
+      const Matrix3d meccano = meccano_target_inverse(t);
       guard.push_back(star_tet(a * meccano, meccano, local));
     }
   }
@@ -1061,9 +1065,6 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
   improving_ = &options;
   floors_ = options.floors();
   tangled_ = false;
-  aim_at(SmoothingTarget::meccano);
-  guard_inverses_ = std::move(target_inverses_);
-  guard_of_tet_ = std::move(target_of_tet_);
   aim_at(SmoothingTarget::equilateral);
   std::vector<std::uint8_t> movable(mesh_.points.size(), 0);
   for (VertexId v : free_nodes()) movable[v] = only.empty() || only[v];
@@ -1083,7 +1084,8 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
         for (const TetId t : stars_.of(v)) in_star[t] = 1;
     std::vector<TetId> others;
     for (TetId t = 0; t < mesh_.num_tets(); ++t) (in_star[t] ? measured : others).push_back(t);
-    unmeasured = smallest_mean_ratios(mesh_, others);
+    unmeasured = {smallest_over(others, [&](TetId t) { return mean_ratio_equilateral(oriented_points(mesh_, t)); }),
+                  smallest_over(others, [&](TetId t) { return mean_ratio_meccano(mesh_, t); })};
   }
   std::vector<double> quality(mesh_.tets.size(), infinity);
   // Passes over the tets whose quality (tet_quality) is below `limit`: each optimises their movable nodes
@@ -1095,6 +1097,7 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
     int count = 0;
     std::int64_t updates = 0, moved = 0, below_before = 0, below_after = 0;
     double min_before = 0.0, min_after = 0.0;
+    std::vector<TetId> touched;  // the stars of the nodes updated, sorted
   };
   auto run_passes = [&](auto tet_quality, double limit, bool (Smoother::*update)(VertexId), bool skip_settled,
                         const std::string& pass_name, const std::string& where) {
@@ -1143,6 +1146,7 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
       std::sort(touched.begin(), touched.end());
       touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
       measure_tets(touched);
+      passes.touched.insert(passes.touched.end(), touched.begin(), touched.end());
       if (skip_settled) {
         for (VertexId v : nodes) settled[v] = !moved_now[v];
         for (VertexId v : nodes)
@@ -1161,6 +1165,8 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
     }
     passes.below_after = below();
     passes.min_after = smallest();
+    std::sort(passes.touched.begin(), passes.touched.end());
+    passes.touched.erase(std::unique(passes.touched.begin(), passes.touched.end()), passes.touched.end());
     return passes;
   };
   ImprovementStats stats;
@@ -1177,7 +1183,9 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
     // The shape passes trade either mean ratio for angles only above the mesh's minimum after the Newton
     // passes: neither minimum falls.
     shape_mean_ratio_floor_ = std::min(newton.min_after, unmeasured.equilateral) / options.threshold;
-    shape_meccano_floor_ = std::min(smallest_mean_ratios(mesh_, measured).meccano, unmeasured.meccano);
+    shape_meccano_floor_ =
+        std::min(smallest_over(measured, [&](TetId t) { return mean_ratio_meccano(mesh_, t); }), unmeasured.meccano);
+    std::vector<double> equilateral = quality;  // the Newton passes' measure, which the shape passes replace
     // Most nodes of the tets left outside the floors are held (by the guards, or neighbours that stay):
     // trying them again cost as much as the first pass for a few per cent of moves.
     const Passes shape =
@@ -1188,12 +1196,12 @@ ImprovementStats Smoother::improve(const ImprovementOptions& options, std::span<
     stats.shape_nodes_moved = shape.moved;
     stats.tets_outside_floors_before = shape.below_before;
     stats.tets_outside_floors_after = shape.below_after;
-    // The shape passes may lower mean ratios above the mesh's minimum: count the tets below the threshold
-    // again.
-    for (const TetId t : measured) quality[t] = mean_ratio_equilateral(oriented_points(mesh_, t));
+    // The shape passes may lower mean ratios above the mesh's minimum, in the stars they touched: count the
+    // tets below the threshold again.
+    for (const TetId t : shape.touched) equilateral[t] = mean_ratio_equilateral(oriented_points(mesh_, t));
     stats.tets_below_after =
-        std::count_if(quality.begin(), quality.end(), [&](double q) { return q < options.threshold; });
-    stats.min_quality_after = measured.empty() ? 0.0 : *std::min_element(quality.begin(), quality.end());
+        std::count_if(equilateral.begin(), equilateral.end(), [&](double q) { return q < options.threshold; });
+    stats.min_quality_after = measured.empty() ? 0.0 : *std::min_element(equilateral.begin(), equilateral.end());
   }
   improving_ = nullptr;
   return stats;
@@ -1280,9 +1288,9 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
   // improve() sets both targets; SUS's mode and band decide which nodes are free. A flip changes the
   // stars, so each round smooths with a Smoother built afresh.
   auto smooth = [&](std::span<const std::uint8_t> only) {
-    return Smoother(mesh, surfaces,
-                    {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})
-        .improve(options, only);
+    auto sm = Smoother(mesh, surfaces,
+                       {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings});
+    return sm.improve(options, only);
   };
   const FlipStats mends = options.topology ? conform_to_creases(mesh, surfaces, regions, options) : FlipStats{};
   if (options.topology && options.progress) options.progress("improvement creases: " + describe(mends));

@@ -109,6 +109,7 @@ class Flipper {
   // changes which edges the lines cross; each crossing gets the best of its mends (mend_crossing).
   FlipStats conform_to_creases() {
     double worst = std::numeric_limits<double>::infinity();
+#pragma omp parallel for schedule(static) reduction(min : worst)
     for (TetId t = 0; t < mesh_.num_tets(); ++t) worst = std::min(worst, quality(mesh_.oriented_tet(t)));
     mend_floor_ = std::max(std::pow(mend_floor, 3), worst);  // quality() is cubed
     index_incident();
@@ -180,12 +181,14 @@ class Flipper {
   std::vector<std::pair<double, TetId>> worst_of(std::vector<TetId>& tets) const {
     std::sort(tets.begin(), tets.end());
     tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
+    std::vector<double> qualities(tets.size());  // measured in parallel, taken in order
+    const auto count = static_cast<std::int64_t>(tets.size());
+#pragma omp parallel for schedule(static)
+    for (std::int64_t i = 0; i < count; ++i)
+      qualities[i] = dead(tets[i]) ? std::numeric_limits<double>::infinity() : quality(mesh_.oriented_tet(tets[i]));
     std::vector<std::pair<double, TetId>> worst;
-    for (TetId t : tets) {
-      if (dead(t)) continue;
-      const double q = quality(mesh_.oriented_tet(t));
-      if (q < cubed_threshold()) worst.emplace_back(q, t);
-    }
+    for (std::int64_t i = 0; i < count; ++i)
+      if (qualities[i] < cubed_threshold()) worst.emplace_back(qualities[i], tets[i]);
     std::sort(worst.begin(), worst.end());
     return worst;
   }

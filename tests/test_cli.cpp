@@ -428,6 +428,20 @@ MshNodes read_nodes_and_views(const std::string& file) {
   return read;
 }
 
+// --retry-after-quality-loss is accepted and changes nothing for steps that move without a loss.
+TEST_F(CliTest, SequenceTakesTheRetryAfterQualityLossFlag) {
+  std::string steps;
+  for (int k = 0; k < 2; ++k) {
+    TriangleSurface patch = testing::paper_like_patch(10);
+    for (Eigen::Vector3d& p : patch.points) p.z() += k * 0.0625 / 4;
+    steps += " --step " + write_obj("retry_" + std::to_string(k) + ".obj", patch) + ":fault";
+  }
+  const CliRun run = run_cli("sequence --box 0,0,0,1,1,1 --level 3 --resolution 0.0625" + steps +
+                             " --retry-after-quality-loss --output " + path("retry_{step}.msh"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("step 1: moved"), std::string::npos) << run.output;
+}
+
 // A patch raised by a quarter of l_r per step: one file per step, every step checked, and each node's
 // previous_node a node of the previous step's file at the same position; the report counts them.
 TEST_F(CliTest, SequenceWritesEveryStepWithItsPreviousNodesAndAReport) {

@@ -38,8 +38,8 @@ int local_face_towards(const TetMesh& mesh, TetId t, TetId n) {
 void expect_problem(const TetMesh& mesh, const std::string& words) {
   const MeshInvariantReport report = verify_mesh(mesh);
   EXPECT_FALSE(report.ok());
-  EXPECT_TRUE(std::ranges::any_of(report.problems,
-                                  [&](const std::string& p) { return p.find(words) != std::string::npos; }))
+  EXPECT_TRUE(
+      std::ranges::any_of(report.problems, [&](const std::string& p) { return p.find(words) != std::string::npos; }))
       << "no problem mentions \"" << words << "\":\n"
       << report.summary();
 }
@@ -66,7 +66,8 @@ TEST(MeshInvariants, ANeighbourThatDoesNotHoldTheFaceIsReported) {
   TetMesh mesh = make_cube_meccano({{0, 0, 0}, {3, 2, 1}}, 3);  // in one cell every tet meets the centre
   const InteriorFace face = interior_face(mesh);
   TetId far = 0;  // a tet sharing no vertex with the face's tet
-  while (std::ranges::any_of(mesh.tets[far], [&](VertexId v) { return std::ranges::count(mesh.tets[face.tet], v) > 0; }))
+  while (
+      std::ranges::any_of(mesh.tets[far], [&](VertexId v) { return std::ranges::count(mesh.tets[face.tet], v) > 0; }))
     ++far;
   ASSERT_LT(far, mesh.num_tets());
   mesh.neighbours[face.tet][face.face] = far;

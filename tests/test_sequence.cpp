@@ -195,5 +195,21 @@ TEST(SurfaceSequence, InsertsAnewWhenAskedOrWhenTheTriangulationChanges) {
   EXPECT_LT(largest_node_distance(jump.result, jumped), 1e-12);
 }
 
+// A move that lost quality goes straight to the new insertion unless retry_after_quality_loss asks for
+// the second move; a loss of -1 makes every move lose quality.
+TEST(SurfaceSequence, AMoveThatLostQualityIsNotTriedAgainUnlessAsked) {
+  const TetMesh meccano = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, {1, 1, 1}, 6);
+  for (const bool retry : {false, true}) {
+    SurfaceSequence sequence(meccano, band_options(), {.max_quality_loss = -1.0, .retry_after_quality_loss = retry});
+    sequence.advance({patch_at(0)});
+    const SequenceStep& step = sequence.advance({patch_at(1)});
+    SCOPED_TRACE(step.inserted_because);
+    EXPECT_EQ(step.kind, StepKind::inserted);
+    EXPECT_EQ(step.inserted_because.rfind("moving lost quality: ", 0), 0u);
+    EXPECT_EQ(step.inserted_because.find("moving again") != std::string::npos, retry);
+    EXPECT_TRUE(verify_mesh(step.result.mesh).ok());
+  }
+}
+
 }  // namespace
 }  // namespace meccano

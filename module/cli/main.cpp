@@ -175,8 +175,10 @@ triangulation changed (a surface clipped by the box changes it when a vertex cro
 a vertex moved farther than --max-move l_r (default 1), when a surface's area differs from its area at
 the last insertion by more than --max-area-change of it (default 0.1: a growing surface stretches the
 refinement made for it), or when the moved mesh stays tangled or its worst tet falls more than
---max-quality-loss (default 0.02, either mean ratio) below what the insertions gave. --from-scratch
-inserts every step anew.
+--max-quality-loss (default 0.02, either mean ratio) below what the insertions gave. A move that
+leaves tets tangled is tried again with two rings and SUS; one that loses quality is not, unless
+--retry-after-quality-loss (that second move has not kept the quality where the first lost it).
+--from-scratch inserts every step anew.
 
 check FILE.msh checks the invariants of a tet mesh of a box in any Gmsh MSH file (2.2 or 4.1, ASCII or
 binary; this tool's, Gmsh's, ...): conformity, orientation, volume, the box sides xmin ... zmax (if the
@@ -648,6 +650,7 @@ SequenceOptions parse_sequence_options(const std::vector<std::string>& args) {
   parser.value({"--max-area-change"}, [&](const std::string& text) {
     parsed.sequence.max_area_change = meccano::tools::parse_non_negative("--max-area-change", text);
   });
+  parser.flag({"--retry-after-quality-loss"}, [&] { parsed.sequence.retry_after_quality_loss = true; });
   declare_method_options(parser, options);
   declare_output_options(parser, options, output_format, msh_version_unused);
   parser.parse(args);

@@ -60,15 +60,18 @@ std::optional<InsertionResult> SurfaceSequence::try_moving(const std::vector<Tri
   std::string failures;
   for (const MoveOptions& move : sequence_.moves) {
     std::string failure;
+    bool lost_quality = false;
     try {
       InsertionResult moved = move_surfaces(last_->result, surfaces, options_, move);
       failure = quality_loss(moved.quality_after_smoothing, inserted_quality_, sequence_.max_quality_loss);
       if (failure.empty()) return moved;
       failure = "lost quality: " + failure;
+      lost_quality = true;
     } catch (const MeshingError& error) {
       failure = std::string("failed: ") + error.what();
     }
     failures += (failures.empty() ? "moving " : "; moving again ") + failure;
+    if (lost_quality && !sequence_.retry_after_quality_loss) break;
   }
   why = failures;
   return std::nullopt;

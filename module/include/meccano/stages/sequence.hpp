@@ -7,10 +7,12 @@
 //          triangulations (only points moved) moves the previous step's interface onto them
 //          (move_surfaces), trying SequenceOptions::moves in turn: first six rings of nodes follow the
 //          interface and the improvement alone restores the mesh around it (a tenth of an insertion's
-//          cost on a fault, design.md "A moving interface"); if tets stay inverted or the quality does not
-//          hold, two rings follow and SUS smooths the band before the improvement. SUS keeps the paper's
-//          measure better on smooth surfaces, but from a valid start on meshes with tiny tets (crease
-//          splits) it can tangle them and then costs as much as an insertion, hence second.
+//          cost on a fault, design.md "A moving interface"); if tets stay inverted, two rings follow and
+//          SUS smooths the band before the improvement (after a loss of quality only with
+//          `retry_after_quality_loss`: that move has not kept the quality where the first lost it).
+//          SUS keeps the paper's measure better on smooth surfaces, but from a valid start on meshes
+//          with tiny tets (crease splits) it can tangle them and then costs as much as an insertion,
+//          hence second.
 //          Away from the interface the mesh stays the previous step's, node for node. The step inserts
 //          the surfaces anew instead, from the meccano mesh, when
 //            - a triangulation changed (a surface clipped by the box, given clipped, changes its triangulation
@@ -53,6 +55,11 @@ struct SequenceOptions {
   double max_area_change = 0.1;          // as a share of a surface's area at the last insertion
   // The ways a step is moved, tried in turn before it is inserted anew: the cheap one first.
   std::vector<MoveOptions> moves{{.drag_rings = 6, .smooth = false}, {.drag_rings = 2, .smooth = true}};
+  // Whether a move that lost quality (rather than failing to untangle) is followed by the next one. The
+  // later moves drag fewer rings: since the improvement's ladder, none of them has kept the quality where
+  // the first lost it (0 of 4 on the faults and the cube example; their worst meccano tets 0.02-0.06
+  // lower still), and each cost an insertion's time before the insertion (doc/comparison.md).
+  bool retry_after_quality_loss = false;
 };
 
 enum class StepKind { inserted, moved };

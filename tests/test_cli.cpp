@@ -44,6 +44,18 @@ class CliTest : public testing::ScratchDirectoryTest {
     return testing::write_obj(path(name), surface);
   }
 
+  // " --step FILE:fault" for each of `count` steps of the test patch raised by a quarter of l_r = 1/16
+  // per step, written as NAME_k.obj.
+  std::string patch_steps(const std::string& name, int count) const {
+    std::string steps;
+    for (int k = 0; k < count; ++k) {
+      TriangleSurface patch = testing::paper_like_patch(10);
+      for (Eigen::Vector3d& p : patch.points) p.z() += k * 0.0625 / 4;
+      steps += " --step " + write_obj(name + "_" + std::to_string(k) + ".obj", patch) + ":fault";
+    }
+    return steps;
+  }
+
   // The surfaces as one GOCAD TSurf object, a TFACE each, followed by `extra` lines. No coordinate
   // system: the unit cube is not in metres.
   std::string write_tsurf(const std::string& name, const std::vector<TriangleSurface>& surfaces,
@@ -430,13 +442,7 @@ MshNodes read_nodes_and_views(const std::string& file) {
 
 // --retry-after-quality-loss is accepted and changes nothing for steps that move without a loss.
 TEST_F(CliTest, SequenceTakesTheRetryAfterQualityLossFlag) {
-  std::string steps;
-  for (int k = 0; k < 2; ++k) {
-    TriangleSurface patch = testing::paper_like_patch(10);
-    for (Eigen::Vector3d& p : patch.points) p.z() += k * 0.0625 / 4;
-    steps += " --step " + write_obj("retry_" + std::to_string(k) + ".obj", patch) + ":fault";
-  }
-  const CliRun run = run_cli("sequence --box 0,0,0,1,1,1 --level 3 --resolution 0.0625" + steps +
+  const CliRun run = run_cli("sequence --box 0,0,0,1,1,1 --level 3 --resolution 0.0625" + patch_steps("retry", 2) +
                              " --retry-after-quality-loss --output " + path("retry_{step}.msh"));
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_NE(run.output.find("step 1: moved"), std::string::npos) << run.output;
@@ -445,12 +451,7 @@ TEST_F(CliTest, SequenceTakesTheRetryAfterQualityLossFlag) {
 // A patch raised by a quarter of l_r per step: one file per step, every step checked, and each node's
 // previous_node a node of the previous step's file at the same position; the report counts them.
 TEST_F(CliTest, SequenceWritesEveryStepWithItsPreviousNodesAndAReport) {
-  std::string steps;
-  for (int k = 0; k < 3; ++k) {
-    TriangleSurface patch = testing::paper_like_patch(10);
-    for (Eigen::Vector3d& p : patch.points) p.z() += k * 0.0625 / 4;
-    steps += " --step " + write_obj("patch_" + std::to_string(k) + ".obj", patch) + ":fault";
-  }
+  const std::string steps = patch_steps("patch", 3);
   const CliRun run =
       run_cli("sequence --box 0,0,0,1,1,1 --level 3 --resolution 0.0625" + steps + " --output " +
               path("fault_{step}.msh") + " --output " + path("fault_{step}.vtu") + " --report " + path("steps.json"));

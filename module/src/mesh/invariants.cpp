@@ -119,8 +119,7 @@ class Checker {
 
   // The local face of tet n with the vertices of tet t's face f, if it has one.
   std::optional<int> matching_face(TetId t, int f, TetId n) const {
-    std::array<VertexId, 3> face{};
-    for (int k = 0; k < 3; ++k) face[k] = mesh_.tets[t][face_vertices[f][k]];
+    const std::array<VertexId, 3> face = mesh_.outward_face(t, f);
     int outside = -1, count = 0;
     for (int g = 0; g < 4; ++g)
       if (std::find(face.begin(), face.end(), mesh_.tets[n][g]) == face.end()) {
@@ -157,8 +156,7 @@ class Checker {
 
   void check_boundary_face(TetId t, int f, std::array<int128, 6>& side_area) {
     ++report_.boundary_faces;
-    std::array<VertexId, 3> face{};
-    for (int k = 0; k < 3; ++k) face[k] = mesh_.tets[t][face_vertices[f][k]];
+    const std::array<VertexId, 3> face = mesh_.outward_face(t, f);  // the order matters to neither use
     const int side = box_side_of(face);
     if (side < 0) {
       problem("tet ", t, " face ", f, " has no neighbour but is not on the box boundary (a hole)");

@@ -1285,12 +1285,12 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
     stats.flips += lifted.flips;
     return stats;
   }
-  // improve() sets both targets; SUS's mode and band decide which nodes are free. A flip changes the
+  // improve() aims at the equilateral tet and guards the meccano measure; SUS's mode and band decide which nodes are free. A flip changes the
   // stars, so each round smooths with a Smoother built afresh.
   auto smooth = [&](std::span<const std::uint8_t> only) {
-    auto sm = Smoother(mesh, surfaces,
-                       {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings});
-    return sm.improve(options, only);
+    return Smoother(mesh, surfaces,
+                    {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})
+        .improve(options, only);
   };
   const FlipStats mends = options.topology ? conform_to_creases(mesh, surfaces, regions, options) : FlipStats{};
   if (options.topology && options.progress) options.progress("improvement creases: " + describe(mends));

@@ -147,6 +147,33 @@ TEST(Improvement, ALadderIsTheStageAtTheFirstThresholdThenAtTheThreshold) {
   EXPECT_EQ(finished.first_threshold, 0.0) << "one stage";
 }
 
+// A mesh with no tet below first_threshold has no worst tets to lift first: the ladder is the stage at
+// the threshold alone, and says so.
+TEST(Improvement, ALadderWithNoTetBelowItsFirstThresholdIsOneStage) {
+  ImprovementOptions options;
+  options.topology = true;
+  const TetMesh slivers = mesh_with_slivers();
+  const double smallest = summarize_quality(slivers).equilateral.min;
+  ASSERT_GT(smallest, 0.0);
+  ASSERT_LT(smallest, options.threshold);
+  options.first_threshold = smallest;  // nothing is below it
+  ImprovementOptions one_stage = options;
+  one_stage.first_threshold = 0.0;
+  TetMesh laddered = slivers, single = slivers;
+
+  const ImprovementStats ladder = improve_worst_tets(laddered, {}, options);
+  const ImprovementStats stage = improve_worst_tets(single, {}, one_stage);
+
+  EXPECT_GT(stage.node_updates, 0) << "the stage had nothing to do: the case tests nothing";
+  EXPECT_EQ(laddered.points, single.points);
+  EXPECT_EQ(laddered.tets, single.tets);
+  EXPECT_EQ(ladder.node_updates, stage.node_updates);
+  EXPECT_EQ(ladder.flips.operations(), stage.flips.operations());
+  EXPECT_EQ(ladder.first_threshold, 0.0);
+  EXPECT_EQ(ladder.min_quality_before, smallest);
+  EXPECT_EQ(ladder.min_quality_after, stage.min_quality_after);
+}
+
 // Through the pipeline: the improvement runs by default, keeps the interface on S and never leaves the
 // worst tet worse than SUS did; `Improvement::none` leaves SUS's mesh.
 TEST(Improvement, RunsAfterSmoothingAndKeepsTheInterfaceOnS) {

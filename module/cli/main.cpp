@@ -121,7 +121,8 @@ Options:
                            higher costs more time)
   --improve-first-threshold Q
                            when below --improve-threshold, the improvement runs first at Q, then at
-                           --improve-threshold: the worst tets are lifted first (default 0.35; 0: once)
+                           --improve-threshold: the worst tets are lifted first (default 0.35; 0: once;
+                           once too when no tet is below Q)
   --improve-angles MIN,MAX after the mean ratio, the nodes of tets with a dihedral angle below MIN or
                            above MAX degrees (or a mean ratio below the threshold) raise their star's
                            worst shape against these floors (default 15,150; 0,180: no shape passes)

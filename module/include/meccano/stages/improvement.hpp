@@ -56,7 +56,8 @@
 //          every pass, flip and guard above is local and max-min, so where it ends depends on its path. With
 //          the higher threshold alone the many tets between the two take moves around the worst tets
 //          before they are lifted, and can leave them stuck (benchmarks.md, "The threshold raised to 0.40,
-//          the worst tets first").
+//          the worst tets first"). A mesh with no tet below first_threshold has no worst tets to lift
+//          first: it gets the stage at threshold alone (statistics' first_threshold 0).
 // Output   the improved mesh, still valid and conforming, its S_M nodes still on S; statistics. With
 //          `smooth` the topology and the bisection hierarchy are untouched.
 // Limits   a tet whose four nodes cannot move and that no flip improves (box corners, nodes of two
@@ -85,7 +86,8 @@ struct ImprovementOptions {
   double threshold = 0.40;  // equilateral mean ratio below which a tet is improved
   // When below `threshold`, the whole stage runs first with this threshold, then with `threshold`: the
   // worst tets are lifted before the many between the two take the passes' and flips' moves (a single
-  // stage at 0.40 left a surface's worst tet at 0.25, where one at 0.35 first reached 0.40). 0: one stage.
+  // stage at 0.40 left a surface's worst tet at 0.25, where one at 0.35 first reached 0.40). 0: one stage;
+  // one stage too when no tet is below it.
   double first_threshold = 0.35;
   int max_passes = 10;   // smoothing passes per round
   int newton_steps = 8;  // per node and pass

@@ -250,13 +250,17 @@ void project_onto_surfaces(InsertionResult& result, std::span<const TriangleSurf
 
 // Every node within `rings` edge rings of a moved node (`moved`, with its `displacement`) but not moved
 // itself follows it, along the axes the box leaves it: by the mean full displacement of its neighbours
-// in the rings before, times 1 - r / R, r its distance from the moved nodes along the mesh's edges and R
-// the distance of the nearest node of ring rings + 1 (which, like every node beyond R, stays put; if the
-// rings hold the whole mesh, (rings + 1) / rings times the farthest dragged node's distance). The
-// tets beside the interface then keep their shape instead of being squeezed or inverted, and SUS has less
-// to do. The fade goes by distance, not by ring: by ring, the two ends of a tet's edge moved by shares
-// 1/(rings + 1) apart whatever its length, which crushed the metre-long tets of crease splits on faults.
-// Returns the number of nodes that moved.
+// in the rings before, times min(1, (R - r) / (R - r_1)), r its distance from the moved nodes along the
+// mesh's edges, r_1 the largest such distance in the first ring and R the distance of the nearest node
+// of ring rings + 1 (which, like every node beyond R, stays put; if the rings hold the whole mesh,
+// (rings + 1) / rings times the farthest dragged node's distance). The tets beside the interface then
+// keep their shape instead of being squeezed or inverted, and SUS has less to do. The first ring follows
+// whole, so the tets standing on the moved nodes keep their shape exactly under a translation: faded
+// from r = 0, they were sheared a little by every step of a moving interface, and their paper's measure
+// fell by about 0.0013 a step until the step was inserted anew (doc/comparison.md, "The first ring
+// carried whole"). The fade goes by distance, not by ring: by ring, the two ends of a tet's edge moved by
+// shares 1/(rings + 1) apart whatever its length, which crushed the metre-long tets of crease splits on
+// faults. Returns the number of nodes that moved.
 std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector<Eigen::Vector3d> displacement,
                              int rings) {
   const VertexTets stars = vertex_to_tets(mesh);
@@ -268,6 +272,7 @@ std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std
       distance[v] = 0.0;
     }
   double reach = std::numeric_limits<double>::infinity();  // R
+  double first_ring = 0.0;                                  // r_1
   for (int ring = 1; ring <= rings + 1 && !frontier.empty(); ++ring) {
     std::vector<VertexId> next;
     for (const VertexId v : frontier)
@@ -290,6 +295,7 @@ std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std
             ++count;
           }
       displacement[w] = sum / count;
+      if (ring == 1) first_ring = std::max(first_ring, distance[w]);
       if (ring > rings) reach = std::min(reach, distance[w]);
     }
     for (const VertexId w : next) moved[w] = 1;
@@ -301,11 +307,12 @@ std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std
     for (const VertexId w : dragged) farthest = std::max(farthest, distance[w]);
     reach = farthest * (rings + 1) / rings;
   }
+  if (!(first_ring < reach)) first_ring = 0.0;  // a single ring, or a next ring nearer than the first's farthest
   std::int64_t followed = 0;
   for (const VertexId w : dragged) {
     if (!(distance[w] < reach)) continue;
     ++followed;
-    Eigen::Vector3d d = (1.0 - distance[w] / reach) * displacement[w];
+    Eigen::Vector3d d = std::min(1.0, (reach - distance[w]) / (reach - first_ring)) * displacement[w];
     const std::uint8_t planes = mesh.meccano.box_planes(mesh.grid[w]);
     for (int axis = 0; axis < 3; ++axis)
       if (planes & (3u << (2 * axis))) d[axis] = 0.0;

@@ -272,7 +272,7 @@ std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std
       distance[v] = 0.0;
     }
   double reach = std::numeric_limits<double>::infinity();  // R
-  double first_ring = 0.0;                                  // r_1
+  double first_ring = 0.0;                                 // r_1
   for (int ring = 1; ring <= rings + 1 && !frontier.empty(); ++ring) {
     std::vector<VertexId> next;
     for (const VertexId v : frontier)

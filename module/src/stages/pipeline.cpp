@@ -12,12 +12,16 @@
 
 #include <omp.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <limits>
+#include <optional>
+#include <span>
 #include <sstream>
 
 namespace meccano {
@@ -248,21 +252,51 @@ void project_onto_surfaces(InsertionResult& result, std::span<const TriangleSurf
   }
 }
 
+// The displacement at x of the rigid motion that best carries `from` onto `to` (least squares: the
+// rotation from the SVD of their centred cross-covariance, Kabsch's), or none when the points do not fix a
+// rotation (fewer than three, or nearly on a line).
+std::optional<Eigen::Vector3d> rigid_displacement(std::span<const Eigen::Vector3d> from,
+                                                  std::span<const Eigen::Vector3d> to, const Eigen::Vector3d& x) {
+  if (from.size() < 3) return std::nullopt;
+  Eigen::Vector3d from_centre = Eigen::Vector3d::Zero(), to_centre = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    from_centre += from[i];
+    to_centre += to[i];
+  }
+  from_centre /= static_cast<double>(from.size());
+  to_centre /= static_cast<double>(to.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero(), spread = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    covariance += (from[i] - from_centre) * (to[i] - to_centre).transpose();
+    spread += (from[i] - from_centre) * (from[i] - from_centre).transpose();
+  }
+  const Eigen::Vector3d extent = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(spread).eigenvalues();  // ascending
+  if (!(extent[1] > 1e-6 * extent[2])) return std::nullopt;
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d sign = Eigen::Matrix3d::Identity();
+  sign(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  const Eigen::Matrix3d rotation = svd.matrixV() * sign * svd.matrixU().transpose();
+  return rotation * (x - from_centre) + to_centre - x;
+}
+
 // Every node within `rings` edge rings of a moved node (`moved`, with its `displacement`) but not moved
 // itself follows it, along the axes the box leaves it: by the mean full displacement of its neighbours
-// in the rings before, times min(1, (R - r) / (R - r_1)), r its distance from the moved nodes along the
+// in the rings before (with `rigid_first_ring`, in the first ring, the displacement of the rigid motion
+// that best carries its moved neighbours, where they fix one), times min(1, (R - r) / (R - r_1)), r its distance from the moved nodes along the
 // mesh's edges, r_1 the largest such distance in the first ring and R the distance of the nearest node
 // of ring rings + 1 (which, like every node beyond R, stays put; if the rings hold the whole mesh,
 // (rings + 1) / rings times the farthest dragged node's distance). The tets beside the interface then
 // keep their shape instead of being squeezed or inverted, and SUS has less to do. The first ring follows
-// whole, so the tets standing on the moved nodes keep their shape exactly under a translation: faded
-// from r = 0, they were sheared a little by every step of a moving interface, and their paper's measure
-// fell by about 0.0013 a step until the step was inserted anew (doc/comparison.md, "The first ring
-// carried whole"). The fade goes by distance, not by ring: by ring, the two ends of a tet's edge moved by
+// whole (and rigidly, for a moved interface), so the tets standing on the moved nodes keep their shape
+// exactly under a rigid motion: faded from r = 0, they were sheared a little by every step of a moving
+// interface, and their paper's measure fell by about 0.0013 a step until the step was inserted anew;
+// with the mean of the neighbours' displacements, a turned interface still sheared them
+// (doc/comparison.md, "The first ring carried whole"). After a projection, whose moves onto S are no
+// rigid motion, the rigid fit would invert more tets than the mean. The fade goes by distance, not by ring: by ring, the two ends of a tet's edge moved by
 // shares 1/(rings + 1) apart whatever its length, which crushed the metre-long tets of crease splits on
 // faults. Returns the number of nodes that moved.
 std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector<Eigen::Vector3d> displacement,
-                             int rings) {
+                             int rings, bool rigid_first_ring) {
   const VertexTets stars = vertex_to_tets(mesh);
   std::vector<double> distance(mesh.points.size(), std::numeric_limits<double>::infinity());
   std::vector<VertexId> frontier, dragged;
@@ -287,14 +321,38 @@ std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std
     for (const VertexId w : next) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       int count = 0;
+      std::vector<VertexId> leaders;  // the first ring's moved neighbours
       for (const TetId t : stars.of(w))
         for (const VertexId u : mesh.tets[t])
           if (moved[u] == 1) {
             sum += displacement[u];
             distance[w] = std::min(distance[w], distance[u] + (mesh.points[w] - mesh.points[u]).norm());
             ++count;
+            if (ring == 1) leaders.push_back(u);  // moved[u] == 1: a node of S_M
           }
       displacement[w] = sum / count;
+      if (ring == 1 && rigid_first_ring) {
+        std::optional<Eigen::Vector3d> rigid;
+        // Neighbours on one S_M edge, or on a line, fix no rotation: then their moved neighbours too.
+        for (int widened = 0; widened < 2 && !rigid; ++widened) {
+          if (widened == 1) {
+            const std::vector<VertexId> inner = leaders;
+            for (const VertexId u : inner)
+              for (const TetId t : stars.of(u))
+                for (const VertexId x : mesh.tets[t])
+                  if (distance[x] == 0.0) leaders.push_back(x);
+          }
+          std::ranges::sort(leaders);
+          leaders.erase(std::unique(leaders.begin(), leaders.end()), leaders.end());
+          std::vector<Eigen::Vector3d> from, to;
+          for (const VertexId u : leaders) {
+            to.push_back(mesh.points[u]);
+            from.push_back(mesh.points[u] - displacement[u]);
+          }
+          rigid = rigid_displacement(from, to, mesh.points[w]);
+        }
+        if (rigid) displacement[w] = *rigid;
+      }
       if (ring == 1) first_ring = std::max(first_ring, distance[w]);
       if (ring > rings) reach = std::min(reach, distance[w]);
     }
@@ -340,7 +398,7 @@ void drag_rings_after_projection(InsertionResult& result, const std::vector<Eige
         moved[v] = 1;
       }
   result.drag.rings = rings;
-  result.drag.nodes = drag_neighbours(result.mesh, std::move(moved), std::move(displacement), rings);
+  result.drag.nodes = drag_neighbours(result.mesh, std::move(moved), std::move(displacement), rings, false);
   result.drag.inverted_tets = count_inverted(result.mesh);
   report(options, "drag: ", result.drag.nodes, " nodes within ", rings, " rings of the interfaces follow them; ",
          result.drag.inverted_tets, " tets inverted");
@@ -991,7 +1049,8 @@ InsertionResult move_surfaces(const InsertionResult& previous, std::span<const T
     moved.projection_seconds = seconds_since(moving);
   }
   result.drag.rings = move.drag_rings;
-  result.drag.nodes = drag_neighbours(result.mesh, std::move(moved_node), std::move(displacement), move.drag_rings);
+  result.drag.nodes =
+      drag_neighbours(result.mesh, std::move(moved_node), std::move(displacement), move.drag_rings, true);
   const std::int64_t inverted = result.drag.inverted_tets = count_inverted(result.mesh);
   for (SurfaceInsertion& moved : result.surfaces) {
     for (SurfaceProjection& projection : moved.projections) projection.stats.inverted_tets = inverted;

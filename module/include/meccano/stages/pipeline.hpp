@@ -158,9 +158,11 @@ struct MoveOptions {
 //      surface's two halves are cut from it along the same edges at the same fractions as at its
 //      insertion (projection_target), so each half keeps its parametric triangles too.
 //   2. The nodes within move.drag_rings edge rings of S_M follow: a node moves by the mean displacement
-//      of its neighbours in the rings before, along the axes the box leaves it, times
-//      min(1, (R - r) / (R - r_1)), r its distance from S_M along the mesh's edges, r_1 the farthest
-//      first-ring node's and R that of the nearest node of the next ring: the first ring follows whole.
+//      of its neighbours in the rings before (a first-ring node: by the rigid motion that best carries
+//      its S_M neighbours), along the axes the box leaves it, times min(1, (R - r) / (R - r_1)), r its
+//      distance from S_M along the mesh's edges, r_1 the farthest first-ring node's and R that of the
+//      nearest node of the next ring: the first ring follows whole, and the tets standing on S_M keep
+//      their shape under a rigid motion.
 //      The tets beside the interface keep their shape instead of being squeezed or inverted (a quarter
 //      of l_r inverted 10 000 of the cube example's 273 000 tets at l_r = 1/64 without it, none with it).
 //   3. SUS, if the move left tets inverted (or move.smooth), with move.smoothing_sweeps smoothing sweeps;

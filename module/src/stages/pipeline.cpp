@@ -281,20 +281,21 @@ std::optional<Eigen::Vector3d> rigid_displacement(std::span<const Eigen::Vector3
 
 // Every node within `rings` edge rings of a moved node (`moved`, with its `displacement`) but not moved
 // itself follows it, along the axes the box leaves it: by the mean full displacement of its neighbours
-// in the rings before (with `rigid_first_ring`, in the first ring, the displacement of the rigid motion
-// that best carries its moved neighbours, where they fix one), times min(1, (R - r) / (R - r_1)), r its distance from the moved nodes along the
-// mesh's edges, r_1 the largest such distance in the first ring and R the distance of the nearest node
-// of ring rings + 1 (which, like every node beyond R, stays put; if the rings hold the whole mesh,
-// (rings + 1) / rings times the farthest dragged node's distance). The tets beside the interface then
-// keep their shape instead of being squeezed or inverted, and SUS has less to do. The first ring follows
-// whole (and rigidly, for a moved interface), so the tets standing on the moved nodes keep their shape
-// exactly under a rigid motion: faded from r = 0, they were sheared a little by every step of a moving
-// interface, and their paper's measure fell by about 0.0013 a step until the step was inserted anew;
-// with the mean of the neighbours' displacements, a turned interface still sheared them
-// (doc/comparison.md, "The first ring carried whole"). After a projection, whose moves onto S are no
-// rigid motion, the rigid fit would invert more tets than the mean. The fade goes by distance, not by ring: by ring, the two ends of a tet's edge moved by
-// shares 1/(rings + 1) apart whatever its length, which crushed the metre-long tets of crease splits on
-// faults. Returns the number of nodes that moved.
+// in the rings before (with `rigid_first_ring`, a first-ring node by the rigid motion that best carries
+// its moved neighbours, where they fix one), times min(1, (R - r) / (R - r_1)): r its distance from the
+// moved nodes along the mesh's edges, r_1 the largest such distance in the first ring and R the distance
+// of the nearest node of ring rings + 1 (which, like every node beyond R, stays put; if the rings hold
+// the whole mesh, (rings + 1) / rings times the farthest dragged node's distance). The tets beside the
+// interface then keep their shape instead of being squeezed or inverted, and SUS has less to do.
+// The first ring follows whole (and rigidly, for a moved interface), so the tets standing on the moved
+// nodes keep their shape exactly under a rigid motion: faded from r = 0, they were sheared a little by
+// every step of a moving interface, and their paper's measure fell by about 0.0013 a step until the step
+// was inserted anew; moved by the mean of their neighbours' displacements, a turned interface still
+// sheared them (doc/comparison.md, "The first ring carried whole"). After a projection, whose moves onto
+// S are no rigid motion, the rigid fit inverted more tets than the mean. The fade goes by distance, not
+// by ring: by ring, the two ends of a tet's edge moved by shares 1/(rings + 1) apart whatever its
+// length, which crushed the metre-long tets of crease splits on faults. Returns the number of nodes
+// that moved.
 std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std::vector<Eigen::Vector3d> displacement,
                              int rings, bool rigid_first_ring) {
   const VertexTets stars = vertex_to_tets(mesh);
@@ -333,7 +334,8 @@ std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std
       displacement[w] = sum / count;
       if (ring == 1 && rigid_first_ring) {
         std::optional<Eigen::Vector3d> rigid;
-        // Neighbours on one S_M edge, or on a line, fix no rotation: then their moved neighbours too.
+        // Neighbours on one S_M edge, or on a line, fix no rotation: the fit then takes their own S_M
+        // neighbours too.
         for (int widened = 0; widened < 2 && !rigid; ++widened) {
           if (widened == 1) {
             const std::vector<VertexId> inner = leaders;

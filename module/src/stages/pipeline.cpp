@@ -322,28 +322,19 @@ std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std
     for (const VertexId w : next) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       int count = 0;
-      std::vector<VertexId> leaders;  // the first ring's moved neighbours
+      std::vector<VertexId> leaders;  // with rigid_first_ring: a first-ring node's neighbours on S_M
       for (const TetId t : stars.of(w))
         for (const VertexId u : mesh.tets[t])
           if (moved[u] == 1) {
             sum += displacement[u];
             distance[w] = std::min(distance[w], distance[u] + (mesh.points[w] - mesh.points[u]).norm());
             ++count;
-            if (ring == 1) leaders.push_back(u);  // moved[u] == 1: a node of S_M
+            if (ring == 1 && rigid_first_ring) leaders.push_back(u);
           }
       displacement[w] = sum / count;
-      if (ring == 1 && rigid_first_ring) {
-        std::optional<Eigen::Vector3d> rigid;
-        // Neighbours on one S_M edge, or on a line, fix no rotation: the fit then takes their own S_M
-        // neighbours too.
-        for (int widened = 0; widened < 2 && !rigid; ++widened) {
-          if (widened == 1) {
-            const std::vector<VertexId> inner = leaders;
-            for (const VertexId u : inner)
-              for (const TetId t : stars.of(u))
-                for (const VertexId x : mesh.tets[t])
-                  if (distance[x] == 0.0) leaders.push_back(x);
-          }
+      if (!leaders.empty()) {
+        // The rigid motion that carries the leaders, from their positions before the move.
+        auto carried = [&] {
           std::ranges::sort(leaders);
           leaders.erase(std::unique(leaders.begin(), leaders.end()), leaders.end());
           std::vector<Eigen::Vector3d> from, to;
@@ -351,7 +342,16 @@ std::int64_t drag_neighbours(TetMesh& mesh, std::vector<std::uint8_t> moved, std
             to.push_back(mesh.points[u]);
             from.push_back(mesh.points[u] - displacement[u]);
           }
-          rigid = rigid_displacement(from, to, mesh.points[w]);
+          return rigid_displacement(from, to, mesh.points[w]);
+        };
+        std::optional<Eigen::Vector3d> rigid = carried();
+        if (!rigid) {  // on one S_M edge, or a line, they fix no rotation: their own S_M neighbours join
+          const std::vector<VertexId> inner = leaders;
+          for (const VertexId u : inner)
+            for (const TetId t : stars.of(u))
+              for (const VertexId x : mesh.tets[t])
+                if (distance[x] == 0.0) leaders.push_back(x);
+          rigid = carried();
         }
         if (rigid) displacement[w] = *rigid;
       }

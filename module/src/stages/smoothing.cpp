@@ -1292,8 +1292,8 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
     stats.flips += lifted.flips;
     return stats;
   }
-  // improve() aims at the equilateral tet and guards the meccano measure; SUS's mode and band decide which nodes are free. A flip changes the
-  // stars, so each round smooths with a Smoother built afresh.
+  // improve() aims at the equilateral tet and guards the meccano measure; SUS's mode and band decide which
+  // nodes are free. A flip changes the stars, so each round smooths with a Smoother built afresh.
   auto smooth = [&](std::span<const std::uint8_t> only) {
     return Smoother(mesh, surfaces,
                     {.target = SmoothingTarget::equilateral, .mode = sus.mode, .band_rings = sus.band_rings})

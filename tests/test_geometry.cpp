@@ -12,6 +12,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <utility>
 #include <vector>
@@ -643,6 +644,50 @@ TEST(Geometry, HullPointNearestOrigin) {
     ASSERT_GT(x.norm(), 0.0);
     for (const V& p : points) EXPECT_GE(p.dot(x), (1 - 1e-9) * x.squaredNorm()) << "trial " << trial;
   }
+}
+
+// The rigid motion carrying paired points: exact for a rotation and translation (at the points and
+// away from them), a proper rotation even when the pairs are mirror images, none when the points fix
+// no rotation.
+TEST(Geometry, RigidDisplacement) {
+  using V = Eigen::Vector3d;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  auto random_point = [&] { return V(coordinate(rng), coordinate(rng), coordinate(rng)); };
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Matrix3d rotation = Eigen::AngleAxisd(3.0 * coordinate(rng), random_point().normalized()).matrix();
+    const V translation = 10.0 * random_point();
+    std::vector<V> from(3 + trial % 5), to;
+    for (V& p : from) {
+      p = random_point();
+      to.push_back(rotation * p + translation);
+    }
+    for (const V& x : {from[0], V(5.0 * random_point())}) {
+      const std::optional<V> d = rigid_displacement(from, to, x);
+      ASSERT_TRUE(d) << "trial " << trial;
+      EXPECT_LT((x + *d - (rotation * x + translation)).norm(), 1e-12 * (1.0 + x.norm())) << "trial " << trial;
+    }
+  }
+
+  // Mirrored pairs: the best proper rotation keeps the tet's orientation and its edge lengths.
+  const std::vector<V> tet{V(0, 0, 0), V(1, 0, 0), V(0, 2, 0), V(0, 0, 3)};
+  std::vector<V> mirrored, carried;
+  for (const V& p : tet) mirrored.push_back(V(-p.x(), p.y(), p.z()));
+  for (const V& p : tet) carried.push_back(p + *rigid_displacement(tet, mirrored, p));
+  auto volume = [](const std::vector<V>& t) { return (t[1] - t[0]).cross(t[2] - t[0]).dot(t[3] - t[0]); };
+  EXPECT_NEAR(volume(carried), volume(tet), 1e-12);
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) EXPECT_NEAR((carried[i] - carried[j]).norm(), (tet[i] - tet[j]).norm(), 1e-12);
+
+  // Two points, or points on a line, leave the rotation about the line free; a line bent by 1 % fixes it.
+  const std::vector<V> two{V(0, 0, 0), V(1, 0, 0)}, line{V(0, 0, 0), V(1, 1, 1), V(2, 2, 2), V(3, 3, 3)};
+  EXPECT_FALSE(rigid_displacement(two, two, V(0, 1, 0)));
+  EXPECT_FALSE(rigid_displacement(line, line, V(0, 1, 0)));
+  std::vector<V> bent = line;
+  bent[1] += V(0.01, -0.01, 0);
+  const std::optional<V> still = rigid_displacement(bent, bent, V(0, 1, 0));
+  ASSERT_TRUE(still);
+  EXPECT_LT(still->norm(), 1e-12);
 }
 
 }  // namespace

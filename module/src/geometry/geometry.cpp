@@ -1,6 +1,8 @@
 #include <meccano/geometry/geometry.hpp>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 
 #include <algorithm>
 #include <array>
@@ -267,6 +269,30 @@ double tetrahedron_longest_edge(const Tetrahedron3& tet) {
     for (int j = i + 1; j < 4; ++j) longest2 = std::max(longest2, (tet[i] - tet[j]).squaredNorm());
   }
   return std::sqrt(longest2);
+}
+
+std::optional<Eigen::Vector3d> rigid_displacement(std::span<const Eigen::Vector3d> from,
+                                                  std::span<const Eigen::Vector3d> to, const Eigen::Vector3d& x) {
+  if (from.size() < 3) return std::nullopt;
+  Eigen::Vector3d from_centre = Eigen::Vector3d::Zero(), to_centre = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    from_centre += from[i];
+    to_centre += to[i];
+  }
+  from_centre /= static_cast<double>(from.size());
+  to_centre /= static_cast<double>(to.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero(), spread = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    covariance += (from[i] - from_centre) * (to[i] - to_centre).transpose();
+    spread += (from[i] - from_centre) * (from[i] - from_centre).transpose();
+  }
+  const Eigen::Vector3d extent = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(spread).eigenvalues();  // ascending
+  if (!(extent[1] > 1e-6 * extent[2])) return std::nullopt;
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d sign = Eigen::Matrix3d::Identity();
+  sign(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
+  const Eigen::Matrix3d rotation = svd.matrixV() * sign * svd.matrixU().transpose();
+  return rotation * (x - from_centre) + to_centre - x;
 }
 
 Eigen::Vector3d hull_point_nearest_origin(std::span<const Eigen::Vector3d> points) {

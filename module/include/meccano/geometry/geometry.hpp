@@ -20,6 +20,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -40,6 +41,13 @@ double tetrahedron_longest_edge(const Tetrahedron3& tet);
 // algorithm: every point p then has p·x ≥ (1 − 1e-12)|x|², so a step along x raises every p·d at once. For
 // gradients, x is the steepest ascent direction of their minimum, and zero at a max-min optimum.
 Eigen::Vector3d hull_point_nearest_origin(std::span<const Eigen::Vector3d> points);
+
+// The displacement at x of the rigid motion that best carries `from` onto `to` (paired points; least
+// squares: the rotation from the SVD of their centred cross-covariance, Kabsch's, with a reflection
+// turned back into a rotation), or none when the points do not fix a rotation (fewer than three, or so
+// nearly on a line that their spread's middle eigenvalue is below 1e-6 of the largest).
+std::optional<Eigen::Vector3d> rigid_displacement(std::span<const Eigen::Vector3d> from,
+                                                  std::span<const Eigen::Vector3d> to, const Eigen::Vector3d& x);
 
 // Whether the triangle meets the closed tetrahedron: a separating axis test (axis-aligned directions,
 // triangle normal, the 4 face normals, the 18 cross products of a triangle edge and a tetrahedron edge).

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -15,6 +16,8 @@
 #include <numbers>
 #include <numeric>
 #include <optional>
+#include <utility>
+#include <vector>
 
 namespace meccano {
 namespace {
@@ -34,6 +37,14 @@ constexpr double infinity = std::numeric_limits<double>::infinity();
 // 25-40 sweeps, and 1 % constrains the smoothing least (doc/benchmarks.md, "Western Santa Cruz Island
 // without retries").
 constexpr double uv_collapse_floor = 0.01;
+// Nor bring a rim node nearer a rim neighbour, along their side of P, than this fraction of their gap
+// when smoothing began. The area floor does not hold rim nodes apart: the third node of a rim triangle
+// can lie close to the rim (a triangle with two rim edges is split through it, surface_approximation.hpp),
+// and as it moves inward the triangle keeps its area while its rim edge shrinks. On the low-dip hard
+// surface at extent / 100 two rim nodes met so (47 m to 0.4 m, l_r 236 m) and the tet between them and two
+// free nodes stayed inverted for 41 sweeps until the side retry; with 10 % one such tet stayed, with 30 %
+// the mesh untangled in 7 sweeps (doc/benchmarks.md, "Rim nodes kept apart").
+constexpr double rim_gap_floor = 0.3;
 
 // ---------------------------------------------------------------------------------------------------
 // The distortion of one tet as a function of one of its vertices.
@@ -189,6 +200,13 @@ struct NodeFreedom {
   const CreaseLine* crease = nullptr;  // crease: the line of P it moves along
 };
 
+// A rim node's neighbours along S_M's rim (node indices of its surface, -1 for none) and, per neighbour,
+// the least signed difference of their parameters along the node's side of P (rim_gap_floor).
+struct RimNeighbours {
+  std::array<int, 2> node{-1, -1};
+  std::array<double, 2> least_gap{0.0, 0.0};
+};
+
 // How far S_M's triangles around a node stray from S (Smoother::chord_stray).
 struct ChordStray {
   double tilt = 0.0, sag = 0.0;  // radians, length
@@ -304,6 +322,8 @@ class Smoother {
   Jacobian jacobian(VertexId v, const Placement& at) const;
   bool move(VertexId v, const Placement& from, const Parameters& step, Placement& to) const;
   bool keeps_surface_embedded(const NodeFreedom& node, const Vector2d& uv) const;
+  void find_rim_neighbours(int s);
+  bool keeps_rim_gaps(const NodeFreedom& node, double along) const;
   bool optimise(VertexId v);
   bool lift_worst_shape(VertexId v);
   ChordStray chord_stray(VertexId v, const Placement& at) const;
@@ -349,6 +369,7 @@ class Smoother {
   std::vector<std::vector<int>> hints_;  // per surface and node: the triangle of φ^-1(S) last holding it
   std::vector<std::vector<int>> triangle_start_, node_triangles_;  // per surface: node -> S_M triangles (CSR)
   std::vector<std::vector<double>> least_uv_area_;                 // per surface and S_M triangle
+  std::vector<std::vector<RimNeighbours>> rim_neighbours_;         // per surface and node (rim nodes only)
   std::vector<TetId> active_tets_;
   SmoothingStats stats_;
   bool tangled_ = true;  // did the last sweep end with inverted tets (or none ran yet)?
@@ -374,6 +395,7 @@ void Smoother::classify_nodes() {
   triangle_start_.resize(surfaces_.size());
   node_triangles_.resize(surfaces_.size());
   least_uv_area_.resize(surfaces_.size());
+  rim_neighbours_.resize(surfaces_.size());
   for (int s = 0; s < static_cast<int>(surfaces_.size()); ++s) {
     const SurfaceProjection& projection = *surfaces_[s];
     for (const auto& t : projection.triangles)
@@ -414,7 +436,45 @@ void Smoother::classify_nodes() {
       node.kind = (u_on_side && v_on_side) || projection.on_rim[i] == pinned_rim_node ? Freedom::fixed : Freedom::rim;
       node.rim_axis = u_on_side ? 1 : 0;
     }
+    find_rim_neighbours(s);
   }
+}
+
+// Surface s's rim edges are the edges of one S_M triangle each; a sliding rim node keeps rim_gap_floor of
+// its gap to each of its two neighbours along them.
+void Smoother::find_rim_neighbours(int s) {
+  const SurfaceProjection& projection = *surfaces_[s];
+  std::vector<std::pair<int, int>> edges;
+  for (const auto& t : projection.triangles)
+    for (int k = 0; k < 3; ++k) edges.push_back(std::minmax(t[k], t[(k + 1) % 3]));
+  std::ranges::sort(edges);
+  rim_neighbours_[s].assign(projection.nodes.size(), {});
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if (j - i == 1)
+      for (const auto& [a, b] : {edges[i], std::pair{edges[i].second, edges[i].first}}) {
+        const NodeFreedom& node = freedom_[projection.nodes[a]];
+        if (node.kind != Freedom::rim || node.surface != s) continue;  // fixed, or on the other half's S_M
+        RimNeighbours& neighbours = rim_neighbours_[s][a];
+        const int k = neighbours.node[0] < 0 ? 0 : 1;
+        neighbours.node[k] = b;
+        neighbours.least_gap[k] = rim_gap_floor * (projection.uv[a][node.rim_axis] - projection.uv[b][node.rim_axis]);
+      }
+    i = j;
+  }
+}
+
+// Whether a rim node at `along` (its parameter along its side of P) keeps its gaps to its rim neighbours.
+bool Smoother::keeps_rim_gaps(const NodeFreedom& node, double along) const {
+  const RimNeighbours& neighbours = rim_neighbours_[node.surface][node.index];
+  for (int k = 0; k < 2; ++k) {
+    if (neighbours.node[k] < 0) continue;
+    const double gap = along - surfaces_[node.surface]->uv[neighbours.node[k]][node.rim_axis];
+    const double least = neighbours.least_gap[k];
+    if (least > 0.0 ? gap < least : gap > least) return false;
+  }
+  return true;
 }
 
 std::vector<VertexId> Smoother::free_nodes() const {
@@ -589,6 +649,7 @@ bool Smoother::move(VertexId v, const Placement& from, const Parameters& step, P
     case Freedom::rim:
       to.uv[node.rim_axis] += step[0];
       if (!(to.uv[node.rim_axis] > 0.0 && to.uv[node.rim_axis] < 1.0)) return false;
+      if (!keeps_rim_gaps(node, to.uv[node.rim_axis])) return false;
       break;
     case Freedom::crease:
       // Strictly inside the line: its ends are where the crease fades or meets another one.

@@ -23,7 +23,8 @@
 //          triangulation (a short walk from the last triangle); a step that would fold one of S_M's
 //          triangles in P, or shrink it below 1 % of its area in P when smoothing began, is refused, so
 //          S_M stays embedded in S and no two of its nodes slide onto one point. Rim nodes of S move
-//          along their side of P, that is along the rim of S, and the four corners of P stay fixed: a
+//          along their side of P, that is along the rim of S, keeping 30 % of their gap along it to each
+//          rim neighbour when smoothing began, and the four corners of P stay fixed: a
 //          fixed rim would keep the chord-length spacing of the projection, which ignores the volume mesh
 //          behind it. Nodes on a crease of S (surface/creases.hpp) move along their crease line of P,
 //          strictly inside it: they stay on the crease edges of S.

@@ -1,6 +1,7 @@
 // Small helpers shared by the stages that reason about the topology of regions and surfaces of the
-// mesh and of S (stages/volumetric_approximation.cpp, stages/surface_approximation.cpp, surface/creases.cpp, stages/pipeline.cpp,
-// surface/validation.cpp, stages/parameterization.cpp, inspect/mesh_file_check.cpp).
+// mesh and of S (stages/volumetric_approximation.cpp, stages/surface_approximation.cpp,
+// stages/smoothing.cpp, surface/creases.cpp, stages/pipeline.cpp, surface/validation.cpp,
+// stages/parameterization.cpp, inspect/mesh_file_check.cpp).
 // Internal: not installed.
 #pragma once
 

@@ -5,6 +5,8 @@
 #include <meccano/geometry/geometry.hpp>
 #include <meccano/mesh/quality.hpp>
 
+#include "mesh/topology_helpers.hpp"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -444,25 +446,18 @@ void Smoother::classify_nodes() {
 // its gap to each of its two neighbours along them.
 void Smoother::find_rim_neighbours(int s) {
   const SurfaceProjection& projection = *surfaces_[s];
-  std::vector<std::pair<int, int>> edges;
-  for (const auto& t : projection.triangles)
-    for (int k = 0; k < 3; ++k) edges.push_back(std::minmax(t[k], t[(k + 1) % 3]));
-  std::ranges::sort(edges);
+  detail::TopologyScratch scratch;
+  detail::triangle_topology(projection.triangles, scratch);
   rim_neighbours_[s].assign(projection.nodes.size(), {});
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if (j - i == 1)
-      for (const auto& [a, b] : {edges[i], std::pair{edges[i].second, edges[i].first}}) {
-        const NodeFreedom& node = freedom_[projection.nodes[a]];
-        if (node.kind != Freedom::rim || node.surface != s) continue;  // fixed, or on the other half's S_M
-        RimNeighbours& neighbours = rim_neighbours_[s][a];
-        const int k = neighbours.node[0] < 0 ? 0 : 1;
-        neighbours.node[k] = b;
-        neighbours.least_gap[k] = rim_gap_floor * (projection.uv[a][node.rim_axis] - projection.uv[b][node.rim_axis]);
-      }
-    i = j;
-  }
+  for (const detail::Edge& edge : scratch.boundary)
+    for (const auto& [a, b] : {edge, std::pair{edge.second, edge.first}}) {
+      const NodeFreedom& node = freedom_[projection.nodes[a]];
+      if (node.kind != Freedom::rim || node.surface != s) continue;  // fixed, or on the other half's S_M
+      RimNeighbours& neighbours = rim_neighbours_[s][a];
+      const int k = neighbours.node[0] < 0 ? 0 : 1;
+      neighbours.node[k] = b;
+      neighbours.least_gap[k] = rim_gap_floor * (projection.uv[a][node.rim_axis] - projection.uv[b][node.rim_axis]);
+    }
 }
 
 // Whether a rim node at `along` (its parameter along its side of P) keeps its gaps to its rim neighbours.

@@ -1,6 +1,7 @@
 #include <meccano/stages/surface_approximation.hpp>
 #include <meccano/surface/box_clipping.hpp>
 #include <meccano/surface/closed_surface.hpp>
+#include <meccano/surface/narrow_rim.hpp>
 
 #include <meccano/error.hpp>
 #include <meccano/mesh/bisection.hpp>
@@ -470,6 +471,14 @@ std::vector<FaceRef> missing_squares_at(const TetMesh& mesh, const TetRegion& vo
   return missing;
 }
 
+// The longest edge of V_M's tets (those of its level L, or finer).
+double longest_tet_edge(const TetMesh& mesh, const TetRegion& volumetric) {
+  double longest = 0.0;
+  for (TetId t = 0; t < static_cast<TetId>(volumetric.size()); ++t)
+    if (volumetric[t] != 0) longest = std::max(longest, mesh.longest_edge(t));
+  return longest;
+}
+
 // Which side of S a point is on: +1, -1, or 0 when the point is beyond the rim of S, i.e. its closest
 // point on S lies on the rim and it is farther beside S than above or below it (more than 45 degrees
 // from the normal). Beyond the rim the side would only be decided by a tangent plane, and faces there
@@ -477,13 +486,20 @@ std::vector<FaceRef> missing_squares_at(const TetMesh& mesh, const TetRegion& vo
 class SideClassifier {
  public:
   // Where S is clipped by the box, its rim edges on the box are no rim for this purpose: S went on beyond
-  // the box, and the nodes of V_M beside them, on the box, have the side of S's normal there.
-  SideClassifier(const TriangleSurface& surface, const TriangleBVH& tree, const Box& box)
+  // the box, and the nodes of V_M beside them, on the box, have the side of S's normal there. Nor are the
+  // rim edges whose two ends are where S is narrower than `cube_width` (surface/narrow_rim.hpp): around a
+  // strip or tip that fits in V_M's cubes nearly every node lies beyond the rim, and S_M would miss that
+  // part of S. A tip's own vertex has no rim point across it, so the nodes in front of a tip still get
+  // no side, and S_M does not grow past it.
+  SideClassifier(const TriangleSurface& surface, const TriangleBVH& tree, const Box& box, double cube_width)
       : surface_(surface), tree_(tree) {
     TopologyScratch scratch;
     triangle_topology(surface.triangles, scratch);
+    const std::vector<double> widths = rim_widths(surface, cube_width);
+    auto narrow = [&](VertexId v) { return widths[v] < cube_width; };
     for (const Edge& e : scratch.boundary)
-      if ((box_sides(surface.points[e.first], box) & box_sides(surface.points[e.second], box)) == 0)
+      if ((box_sides(surface.points[e.first], box) & box_sides(surface.points[e.second], box)) == 0 &&
+          !(narrow(e.first) && narrow(e.second)))
         rim_edges_.push_back(e);
     rim_vertex_.assign(surface.points.size(), 0);
     for (const Edge& e : rim_edges_) rim_vertex_[e.first] = rim_vertex_[e.second] = 1;
@@ -712,7 +728,7 @@ HealingStats approximate_surface(TetMesh& mesh, TetRegion& volumetric, const Tri
                                  const std::vector<TetRegion*>& other_regions) {
   const FaceTag tag = interface_tag(index);
   const SurfaceKind kind{is_closed(surface), reaches_box(surface, mesh.meccano.box)};
-  const SideClassifier sides(surface, tree, mesh.meccano.box);
+  const SideClassifier sides(surface, tree, mesh.meccano.box, longest_tet_edge(mesh, volumetric));
   const bool closed = kind.closed;
   std::vector<int> sides_to_try;
   switch (closed ? SideRule::positive_only : options.side_rule) {

@@ -7,7 +7,10 @@
 //             (x - p)·n at the closest point p with an angle-weighted pseudo-normal n; a node closer
 //             to S than 1e-12 of its size counts as on the positive side). A node whose closest
 //             point is on the rim of S and which lies more than 45 degrees off the normal there is
-//             beyond the rim and gets no side: there a tangent plane, not S, would decide.
+//             beyond the rim and gets no side: there a tangent plane, not S, would decide. Where S is
+//             narrower than V_M's tets (a strip or sharp tip that fits in its cubes; surface/narrow_rim.hpp,
+//             at the longest edge of V_M's tets) the rim does not count: nearly every node around such a
+//             part lies beyond the rim, and S_M would leave it uncovered.
 //          2. S_M = the boundary faces of V_M, off the box boundary, whose 3 nodes are on the chosen
 //             side. Keep its largest edge-connected component and fill its holes (components of the
 //             rest of ∂V_M other than the largest): beyond the rim of S the side is decided by a

@@ -212,11 +212,11 @@ std::int64_t make_rim_axis_parallel(TetMesh& mesh, const TetRegion& volumetric, 
   }
 }
 
-// Untags the given S_M faces together with every S_M face reachable across oblique edges, so that
-// whole squares go and the rim stays axis-parallel.
-void remove_with_squares(TetMesh& mesh, const Interface& s, std::vector<int> seeds) {
-  std::vector<std::uint8_t> removed(s.faces.size(), 0);
-  for (int f : seeds) removed[f] = 1;
+// The S_M faces of the squares of `seeds`: the seeds and every S_M face reachable from them across
+// oblique edges (per face of s, 1 if taken).
+std::vector<std::uint8_t> faces_of_squares(const TetMesh& mesh, const Interface& s, std::vector<int> seeds) {
+  std::vector<std::uint8_t> taken(s.faces.size(), 0);
+  for (int f : seeds) taken[f] = 1;
   while (!seeds.empty()) {
     const int f = seeds.back();
     seeds.pop_back();
@@ -224,13 +224,19 @@ void remove_with_squares(TetMesh& mesh, const Interface& s, std::vector<int> see
       const VertexId a = s.nodes[f][k], b = s.nodes[f][(k + 1) % 3];
       if (edge_is_axis_parallel(mesh, a, b)) continue;
       s.for_each_face_on_edge(make_edge(a, b), [&](int g) {
-        if (!removed[g]) {
-          removed[g] = 1;
+        if (!taken[g]) {
+          taken[g] = 1;
           seeds.push_back(g);
         }
       });
     }
   }
+  return taken;
+}
+
+// Untags the given S_M faces together with their squares, so that the rim stays axis-parallel.
+void remove_with_squares(TetMesh& mesh, const Interface& s, const std::vector<int>& seeds) {
+  const std::vector<std::uint8_t> removed = faces_of_squares(mesh, s, seeds);
   for (std::size_t f = 0; f < s.faces.size(); ++f)
     if (removed[f]) set_face_tag(mesh, s.faces[f].tet, s.faces[f].local_face, no_face_tag);
 }
@@ -251,6 +257,38 @@ std::vector<int> find_corbels(const Interface& s) {
       }
     }
   return corbels;
+}
+
+// The corbels (pairs of faces, as find_corbels gives them) whose removal keeps S_M in one piece. Where S_M
+// narrows to a strip one square wide (S narrower than V_M's cubes), every square of the strip is a corbel,
+// and removing one would cut off the strip beyond it, which the component clean-up then drops: S_M would
+// leave that part of S uncovered. Such a corbel is left to the dividing-edge rule, which splits its square
+// (its diagonal joins two rim nodes) and so gives it a node off the rim.
+std::vector<int> corbels_keeping_one_piece(const TetMesh& mesh, const Interface& s, const std::vector<int>& corbels) {
+  const std::vector<std::uint8_t> removed = faces_of_squares(mesh, s, corbels);
+  const auto label = edge_components(s.nodes, [&](std::size_t a, std::size_t b) { return !removed[a] && !removed[b]; });
+  std::vector<std::int64_t> size(s.faces.size(), 0);
+  for (std::size_t f = 0; f < s.faces.size(); ++f) size[label[f]] += removed[f] ? 0 : 1;
+  const auto largest = static_cast<std::size_t>(std::max_element(size.begin(), size.end()) - size.begin());
+  // The nodes of the parts that the removal would cut off.
+  std::vector<std::uint8_t> cut_off(mesh.points.size(), 0);
+  bool any_cut_off = false;
+  for (std::size_t f = 0; f < s.faces.size(); ++f)
+    if (!removed[f] && label[f] != largest) {
+      for (VertexId v : s.nodes[f]) cut_off[v] = 1;
+      any_cut_off = true;
+    }
+  if (!any_cut_off) return corbels;
+  std::vector<int> kept;
+  for (std::size_t i = 0; i + 1 < corbels.size(); i += 2) {
+    const std::vector<std::uint8_t> squares = faces_of_squares(mesh, s, {corbels[i], corbels[i + 1]});
+    bool joins = false;
+    for (std::size_t f = 0; f < s.faces.size() && !joins; ++f)
+      if (squares[f])
+        for (VertexId v : s.nodes[f]) joins = joins || cut_off[v] != 0;
+    if (!joins) kept.insert(kept.end(), {corbels[i], corbels[i + 1]});
+  }
+  return kept;
 }
 
 // Angle at corner k of a face, in computational coordinates (exact shapes: 45 or 90 degrees on ∂V_M).
@@ -681,7 +719,7 @@ std::string heal_side(TetMesh& mesh, TetRegion& volumetric, const SideClassifier
     const Interface s = read_interface(mesh, volumetric, tag);
     if (s.faces.empty()) return "S_M became empty";
 
-    if (const auto corbels = find_corbels(s); !corbels.empty()) {
+    if (const auto corbels = corbels_keeping_one_piece(mesh, s, find_corbels(s)); !corbels.empty()) {
       stats.corbels += static_cast<std::int64_t>(corbels.size() / 2);
       remove_with_squares(mesh, s, corbels);
       continue;

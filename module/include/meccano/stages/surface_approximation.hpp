@@ -20,7 +20,10 @@
 //             (cube faces), so every removal below removes whole squares: a face goes with the faces
 //             across its oblique edges.
 // Heal     repeat until nothing changes, the six rules of the paper:
-//             remove corbels (two S_M faces sharing an edge, all of their nodes on the rim);
+//             remove corbels (two S_M faces sharing an edge, all of their nodes on the rim), except
+//             those whose removal would cut S_M in pieces (a strip one square wide, where S is narrower
+//             than the cubes: the part beyond would be dropped as stray); the dividing-edge rule below
+//             splits their squares instead;
 //             rim nodes in 5 or more S_M faces whose fan turns by more than 180 degrees (reflex rim
 //             corners) are filled with the squares S_M lacks there if those lie on this side of S or
 //             beyond its rim, and otherwise left as they are. The paper removes them; removal cuts a

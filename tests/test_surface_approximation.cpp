@@ -121,6 +121,32 @@ TEST(SurfaceApproximation, ReflexCornersAreFilledOnceSoHealingEnds) {
   EXPECT_TRUE(healed.check.is_disk()) << healed.check.describe();
 }
 
+// A strip narrower than V_M's cubes (0.04 wide, the longest edge of V_M's tets 0.06-0.09 here), tilted so
+// that it crosses their layers. Around it nearly every node of V_M lies beyond its rim, and S_M covered
+// nothing of it on either side until the rim stopped counting where S is narrow; where S_M then narrows to
+// one square, its squares are corbels whose removal would cut it, and they are split instead.
+TEST(SurfaceApproximation, AStripNarrowerThanTheCubesIsCoveredAlongItsLength) {
+  for (const double resolution : {1.0 / 12, 1.0 / 16}) {
+    SCOPED_TRACE("l_r = " + std::to_string(resolution));
+    const TriangleSurface strip =
+        testing::graph_patch([](double x, double y) { return 0.3 + 0.4 * x + 0.2 * y; }, {0.1, 0.9}, {0.47, 0.51}, 16);
+    const Healed healed = heal_in_unit_cube(strip, resolution);
+    EXPECT_TRUE(healed.check.healed()) << healed.check.describe();
+    EXPECT_TRUE(healed.check.is_disk()) << healed.check.describe();
+    double low = 1.0, high = 0.0;  // the extent of S_M's nodes along the strip
+    for (TetId t = 0; t < healed.mesh.num_tets(); ++t)
+      for (int f = 0; f < 4; ++f)
+        if (healed.mesh.face_tags[t][f] == interface_tag(0))
+          for (int k = 0; k < 4; ++k)
+            if (k != f) {
+              low = std::min(low, healed.mesh.points[healed.mesh.tets[t][k]].x());
+              high = std::max(high, healed.mesh.points[healed.mesh.tets[t][k]].x());
+            }
+    EXPECT_LT(low, 0.1 + resolution) << "S_M misses the strip's start";
+    EXPECT_GT(high, 0.9 - resolution) << "S_M misses the strip's end";
+  }
+}
+
 TEST(SurfaceApproximation, CheckDetectsUnhealedConfigurations) {
   // The raw S_M (boundary faces of V_M on one side), before any healing, violates the rules.
   TetMesh mesh = make_cube_meccano({{0, 0, 0}, {1, 1, 1}}, 0);

@@ -5,6 +5,7 @@
 #include "mesh/topology_helpers.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>

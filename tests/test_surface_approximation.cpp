@@ -134,14 +134,11 @@ TEST(SurfaceApproximation, AStripNarrowerThanTheCubesIsCoveredAlongItsLength) {
     EXPECT_TRUE(healed.check.healed()) << healed.check.describe();
     EXPECT_TRUE(healed.check.is_disk()) << healed.check.describe();
     double low = 1.0, high = 0.0;  // the extent of S_M's nodes along the strip
-    for (TetId t = 0; t < healed.mesh.num_tets(); ++t)
-      for (int f = 0; f < 4; ++f)
-        if (healed.mesh.face_tags[t][f] == interface_tag(0))
-          for (int k = 0; k < 4; ++k)
-            if (k != f) {
-              low = std::min(low, healed.mesh.points[healed.mesh.tets[t][k]].x());
-              high = std::max(high, healed.mesh.points[healed.mesh.tets[t][k]].x());
-            }
+    for (const auto& triangle : approximation_faces(healed.mesh, healed.region, 0, healed.stats.side).triangles)
+      for (VertexId v : triangle) {
+        low = std::min(low, healed.mesh.points[v].x());
+        high = std::max(high, healed.mesh.points[v].x());
+      }
     EXPECT_LT(low, 0.1 + resolution) << "S_M misses the strip's start";
     EXPECT_GT(high, 0.9 - resolution) << "S_M misses the strip's end";
   }

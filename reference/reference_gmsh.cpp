@@ -29,6 +29,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -244,7 +245,9 @@ void add_named_group(int dim, const std::vector<int>& entities, int tag, const s
 
 // Counts and quality of the tets Gmsh made, measured like every reference's (reference_common.hpp).
 // Gmsh 4.8.4's HXT leaves holes next to the inside of a closed surface on some meshes (tets missing,
-// their neighbours' faces unshared inside the box): such a mesh is no reference, and is refused.
+// their neighbours' faces unshared inside the box), and with several threads it cracks some meshes
+// around an embedded surface: two nodes at one point, the tets on either side each using one of them.
+// Such a mesh is no reference, and is refused, saying which of the two it is.
 void require_no_holes(const std::vector<std::size_t>& tet_nodes, const std::vector<Eigen::Vector3d>& point_of_tag,
                       const meccano::Box& box) {
   std::vector<std::array<meccano::VertexId, 4>> tets(tet_nodes.size() / 4);
@@ -261,15 +264,36 @@ void require_no_holes(const std::vector<std::size_t>& tet_nodes, const std::vect
           return true;
     return false;
   };
+  std::vector<meccano::VertexId> hole_nodes;
   std::size_t holes = 0;
   for (std::size_t i = 0; i < faces.size(); ++i) {
     const bool shared =
         (i + 1 < faces.size() && faces[i + 1].key == faces[i].key) || (i > 0 && faces[i - 1].key == faces[i].key);
-    holes += !shared && !on_box_side(faces[i].key);
+    if (shared || on_box_side(faces[i].key)) continue;
+    ++holes;
+    hole_nodes.insert(hole_nodes.end(), faces[i].key.begin(), faces[i].key.end());
   }
-  if (holes > 0)
-    throw meccano::MeshingError("Gmsh left holes in the mesh: " + std::to_string(holes) +
-                                " tet faces inside the box belong to one tet only (--algorithm delaunay may mesh it)");
+  if (holes == 0) return;
+  // Nodes of the tets by position: a hole's node that shares its point with another node is a crack.
+  std::map<std::array<double, 3>, int> nodes_at;
+  std::vector<char> counted(point_of_tag.size(), 0);
+  for (std::size_t tag : tet_nodes)
+    if (!std::exchange(counted[tag], 1)) {
+      const Eigen::Vector3d& p = point_of_tag[tag];
+      ++nodes_at[{p.x(), p.y(), p.z()}];
+    }
+  std::sort(hole_nodes.begin(), hole_nodes.end());
+  hole_nodes.erase(std::unique(hole_nodes.begin(), hole_nodes.end()), hole_nodes.end());
+  const auto coincident = std::ranges::count_if(hole_nodes, [&](meccano::VertexId v) {
+    const Eigen::Vector3d& p = point_of_tag[static_cast<std::size_t>(v)];
+    return nodes_at.at({p.x(), p.y(), p.z()}) > 1;
+  });
+  throw meccano::MeshingError(
+      "Gmsh left holes in the mesh: " + std::to_string(holes) + " tet faces inside the box belong to one tet only" +
+      (coincident > 0 ? "; " + std::to_string(coincident) + " of their " + std::to_string(hole_nodes.size()) +
+                            " nodes share their point with another node (cracks, as HXT makes with several "
+                            "threads on some meshes: --threads 1 may mesh it)"
+                      : " (--algorithm delaunay may mesh it)"));
 }
 
 meccano::reference::MeshSummary summarize_mesh(const meccano::Box& box) {

@@ -7,10 +7,10 @@ The driver (bash) runs the tools; this file does everything else, as subcommands
                                  (kind fault; skipped with a message if the folder is missing) and the
                                  OBJ surfaces in folder HARD (kind synthetic); only those of NAMES
                                  (comma-separated) if given
-  plan SURFACE full|quick        print the box (the surface's bounding box enlarged on every side by 10 %
+  plan SURFACE full|quick|D,...  print the box (the surface's bounding box enlarged on every side by 10 %
                                  of its largest extent E, as x0,y0,z0,x1,y1,z1) and E, then a line
-                                 "DIVISOR L_R" per resolution l_r = E / DIVISOR (DIVISORS, or
-                                 QUICK_DIVISORS)
+                                 "DIVISOR L_R" per resolution l_r = E / DIVISOR (DIVISORS, QUICK_DIVISORS,
+                                 or the divisors D given)
   subdivide SURFACE EDGE DIR     write SURFACE, read as meccano-immerse reads it, with every triangle
                                  split into 4 at its edge midpoints as often as it takes to bring the
                                  mean edge to at most EDGE, to DIR/STEM_kLEVELS.obj (kept: later calls
@@ -350,9 +350,15 @@ def quality_row(case, divisor, module):
                   f"{s['node_distance']['max']:.1e}"]
 
 
+def on_one_thread(hxt_run):
+    """Whether HXT ran again on one thread after cracking the mesh on several (bench_faults.sh run_hxt)."""
+    return hxt_run["id"].endswith("_1thread")
+
+
 def equal_tets_row(case, divisor, module, hxt_runs):
     tets = module["tets"]
-    sizes = ", ".join(f"{r['parameter']:.4g} ({thousands(r['tets'])})" for r in sorted(hxt_runs, key=lambda r: r["tets"]))
+    sizes = ", ".join(f"{r['parameter']:.4g} ({thousands(r['tets'])}{', 1 thread' if on_one_thread(r) else ''})"
+                      for r in sorted(hxt_runs, key=lambda r: r["tets"]))
     seconds, extrapolated = at_module_tets(hxt_runs, tets, lambda r: r["seconds"])
     if seconds is None:
         return [case, resolution_label(divisor, module), thousands(tets), f"{module['seconds']:.2f}", "no HXT run",
@@ -501,13 +507,21 @@ def deviation_targets(measured, kinds):
 
 
 def speed_target(measured):
-    ratios = [(m["seconds"] / field["seconds"], case, divisor, m, field) for case, divisor, m, field in measured if field]
-    if not ratios:
+    """Target 5 over the graded HXT runs on the bench's threads; those HXT made again on one thread
+    (its meshes on several were cracked) are counted apart: that is not HXT's speed on those threads."""
+    ratios = [(m["seconds"] / field["seconds"], case, divisor, m, field)
+              for case, divisor, m, field in measured if field]
+    same_threads = [r for r in ratios if not on_one_thread(r[4])]
+    one_thread = [r for r in ratios if on_one_thread(r[4])]
+    if not same_threads:
         return "5. **The whole insertion no slower than HXT at equal interface resolution**: no graded HXT run: **NOT MEASURED**."
-    ratio, case, divisor, m, field = worst_of(ratios, lambda r: r[0])
+    ratio, case, divisor, m, field = worst_of(same_threads, lambda r: r[0])
+    apart = (f" Where HXT cracked the mesh on several threads, against HXT on one: {sum(r[0] <= 1 for r in one_thread)} "
+             f"of {len(one_thread)} runs." if one_thread else "")
     return (f"5. **The whole insertion no slower than HXT at equal interface resolution** (module s ≤ graded HXT s): "
-            f"{sum(r[0] <= 1 for r in ratios)} of {len(ratios)} runs; worst: the module {ratio:.2f}× HXT's time "
-            f"({case}, E/{divisor}: {m['seconds']:.2f} s against {field['seconds']:.2f} s). {status(ratio <= 1)}.")
+            f"{sum(r[0] <= 1 for r in same_threads)} of {len(same_threads)} runs; worst: the module {ratio:.2f}× HXT's "
+            f"time ({case}, E/{divisor}: {m['seconds']:.2f} s against {field['seconds']:.2f} s). {status(ratio <= 1)}."
+            + apart)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -544,6 +558,9 @@ l_r = E/30, E/50, E/70, E/100.
   from S (2–4 % of them) have median edges of 0.3–1.2 F (measured at E/30); Gmsh follows the field
   loosely, HXT more so (compare the tet counts), and its seconds include the size callback's distance
   queries (`reference-gmsh` computes the distance to S with meccano's BVH), as in `comparison.md` b).
+- Gmsh 4.8.4's HXT cracks some of these meshes on several threads (two nodes at one point, the tets on
+  either side each using one; `reference-gmsh` refuses such a mesh); that run is listed under Failures,
+  HXT runs again on one thread, and the tables mark its row "1 thread".
 - Seconds are each tool's own total from its report (not the MSH write). Timings are single runs on a
   machine shared with other jobs: compare rows of one run, not runs."""
 
@@ -582,14 +599,23 @@ def write_section(doc_path, section):
     os.replace(temporary, doc_path)
 
 
+def plan_divisors(mode):
+    """The divisors of a plan: DIVISORS for "full", QUICK_DIVISORS for "quick", else the comma-separated
+    positive integers given (None if MODE is none of these)."""
+    if mode in ("full", "quick"):
+        return DIVISORS if mode == "full" else QUICK_DIVISORS
+    divisors = mode.split(",")
+    return tuple(map(int, divisors)) if all(d.isdigit() and int(d) > 0 for d in divisors) else None
+
+
 def main(argv):
     command, args = (argv[1], argv[2:]) if len(argv) > 1 else ("", [])
     if command == "cases" and len(args) in (2, 3):
         list_cases(*args)
-    elif command == "plan" and len(args) == 2 and args[1] in ("full", "quick"):
+    elif command == "plan" and len(args) == 2 and plan_divisors(args[1]):
         box, extent = case_box(read_surface(args[0])[0])
         print(",".join(f"{v:.3f}" for v in box), f"{extent:.6g}")
-        for divisor in DIVISORS if args[1] == "full" else QUICK_DIVISORS:
+        for divisor in plan_divisors(args[1]):
             print(divisor, f"{extent / divisor:.6g}")
     elif command == "subdivide" and len(args) == 3:
         write_subdivided(args[0], float(args[1]), args[2])

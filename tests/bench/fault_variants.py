@@ -2,19 +2,22 @@
 """Variants of the shared faults, inserted through the CLI (doc/robustness.md, "Fault variants").
 
 usage: fault_variants.py [--build DIR] [--work DIR] [--divisors 30,50] [--variants rot37,tilt25,...]
+                         [--margins 0.1,...]
 
 The project is judged on faults it has not seen, so each shared fault (../shared/data/faults) is also
 inserted as something it is not: turned 37 degrees about the vertical (rot37), tilted 25 degrees about
 the east axis (tilt25), with its normals flipped (flip), in kilometres instead of metres (km), and cut
 to a part of itself along its triangles (cropA: the 60 % of its length at one end of its strike, cropB:
 the 45 % at the other; the largest edge-connected part, skipped unless a disk). A cut leaves a jagged
-(sawtooth) rim with notches and 50-60 degree tips, which the shared faults do not have. Each variant is
-written as OBJ and inserted at l_r = E / divisor in the box of bench_faults (its bounding box grown by
-E / 10 per side, E its largest extent); each result is checked with `meccano-immerse check`. Prints one
-line per run: exit status, seconds, tets, retries (finer l_r, other side) and why.
+(sawtooth) rim with notches and 50-60 degree tips, which the shared faults do not have. The variant asis
+is the fault as it is, for other boxes and resolutions (not run by default). Each variant is written as
+OBJ and inserted at l_r = E / divisor in its bounding box grown by margin x E per side (E its largest
+extent; 0.1, bench_faults' box, by default); each result is checked with `meccano-immerse check`. Prints
+one line per run: exit status, seconds, tets, retries (finer l_r, other side) and why.
 """
 import argparse
 import glob
+import itertools
 import json
 import math
 import os
@@ -109,6 +112,7 @@ def rotation(axis, degrees):
 
 def variants(points, triangles):
     centre = points.mean(axis=0)
+    yield "asis", points, triangles
     yield "rot37", (points - centre) @ rotation("z", 37).T + centre, triangles
     yield "tilt25", (points - centre) @ rotation("x", 25).T + centre, triangles
     yield "flip", points, triangles[:, ::-1]
@@ -137,6 +141,7 @@ def main():
     parser.add_argument("--work", default="/tmp/meccano-fault-variants")
     parser.add_argument("--divisors", default="30,50")
     parser.add_argument("--variants", default="rot37,tilt25,flip,km,cropA,cropB")
+    parser.add_argument("--margins", default="0.1", help="box margins, as fractions of E")
     args = parser.parse_args()
     tool = os.path.join(args.build, "module", "meccano-immerse")
     os.makedirs(args.work, exist_ok=True)
@@ -150,9 +155,10 @@ def main():
             used = write_obj(obj, points, triangles)
             low, high = used.min(axis=0), used.max(axis=0)
             extent = (high - low).max()
-            box = ",".join(f"{v:.6f}" for v in list(low - 0.1 * extent) + list(high + 0.1 * extent))
-            for divisor in (int(d) for d in args.divisors.split(",")):
-                msh = os.path.join(args.work, f"{fault}_{variant}_{divisor}.msh")
+            for margin, divisor in itertools.product(map(float, args.margins.split(",")),
+                                                     map(int, args.divisors.split(","))):
+                box = ",".join(f"{v:.6f}" for v in list(low - margin * extent) + list(high + margin * extent))
+                msh = os.path.join(args.work, f"{fault}_{variant}_{margin:g}_{divisor}.msh")
                 command = [tool, "--box", box, "--surface", obj + ":fault", "--resolution", f"{extent / divisor:.6g}",
                            "--output", msh, "--report", msh + ".json", "--quiet"]
                 start = time.time()
@@ -160,14 +166,14 @@ def main():
                 seconds = time.time() - start
                 if run.returncode != 0:
                     why = (run.stderr.strip().splitlines() or ["?"])[-1][:300]
-                    print(f"{fault:36s} {variant:6s} E/{divisor:<3d} FAIL {seconds:7.1f} s  {why}", flush=True)
+                    print(f"{fault:36s} {variant:6s} {margin:<4g} E/{divisor:<3d} FAIL {seconds:7.1f} s  {why}", flush=True)
                     continue
                 check = subprocess.run([tool, "check", msh, "--quiet"], capture_output=True, text=True)
                 report = json.load(open(msh + ".json"))
                 finer = report["surfaces"][0]["resolution"] < 0.999 * extent / divisor
                 status = "ok" if check.returncode == 0 else "INVALID"
                 retries = ("finer " if finer else "") + ("side " if report.get("side_retry") else "")
-                print(f"{fault:36s} {variant:6s} E/{divisor:<3d} {status:4s} {seconds:7.1f} s {report['tets']:>9d} tets "
+                print(f"{fault:36s} {variant:6s} {margin:<4g} E/{divisor:<3d} {status:4s} {seconds:7.1f} s {report['tets']:>9d} tets "
                       f"{retries or '-'} {report.get('side_retry') or ''}"[:400], flush=True)
                 os.remove(msh)
 

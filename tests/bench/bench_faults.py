@@ -613,10 +613,10 @@ def main(argv):
     command, args = (argv[1], argv[2:]) if len(argv) > 1 else ("", [])
     if command == "cases" and len(args) in (2, 3):
         list_cases(*args)
-    elif command == "plan" and len(args) == 2 and plan_divisors(args[1]):
+    elif command == "plan" and len(args) == 2 and (divisors := plan_divisors(args[1])):
         box, extent = case_box(read_surface(args[0])[0])
         print(",".join(f"{v:.3f}" for v in box), f"{extent:.6g}")
-        for divisor in plan_divisors(args[1]):
+        for divisor in divisors:
             print(divisor, f"{extent / divisor:.6g}")
     elif command == "subdivide" and len(args) == 3:
         write_subdivided(args[0], float(args[1]), args[2])

@@ -164,16 +164,17 @@ def main():
                 start = time.time()
                 run = subprocess.run(command, capture_output=True, text=True)
                 seconds = time.time() - start
+                label = f"{fault:36s} {variant:6s} {margin:<4g} E/{divisor:<3d}"
                 if run.returncode != 0:
                     why = (run.stderr.strip().splitlines() or ["?"])[-1][:300]
-                    print(f"{fault:36s} {variant:6s} {margin:<4g} E/{divisor:<3d} FAIL {seconds:7.1f} s  {why}", flush=True)
+                    print(f"{label} FAIL {seconds:7.1f} s  {why}", flush=True)
                     continue
                 check = subprocess.run([tool, "check", msh, "--quiet"], capture_output=True, text=True)
                 report = json.load(open(msh + ".json"))
                 finer = report["surfaces"][0]["resolution"] < 0.999 * extent / divisor
                 status = "ok" if check.returncode == 0 else "INVALID"
                 retries = ("finer " if finer else "") + ("side " if report.get("side_retry") else "")
-                print(f"{fault:36s} {variant:6s} {margin:<4g} E/{divisor:<3d} {status:4s} {seconds:7.1f} s {report['tets']:>9d} tets "
+                print(f"{label} {status:4s} {seconds:7.1f} s {report['tets']:>9d} tets "
                       f"{retries or '-'} {report.get('side_retry') or ''}"[:400], flush=True)
                 os.remove(msh)
 

@@ -549,8 +549,10 @@ TEST_F(CliTest, SequenceRefusesWhatItCannotDoAndWritesNothing) {
 // what the failure means and what may mend it.
 TEST_F(CliTest, AFailureAfterRetriesListsEachAttemptOnOneLine) {
   const std::string surface = write_obj("patch.obj", testing::paper_like_patch(8));
-  const CliRun run = run_cli("--box 0,0,0,1,1,1 --surface " + surface + " --resolution 0.1 --max-sweeps 1 " +
-                             "--fallback-sweeps 0 --finer-retries 1 --quiet --output " + path("mesh.msh"));
+  // --improve smooth: no untangling flips, which would untangle some attempts.
+  const CliRun run =
+      run_cli("--box 0,0,0,1,1,1 --surface " + surface + " --resolution 0.1 --max-sweeps 1 " +
+              "--fallback-sweeps 0 --finer-retries 1 --improve smooth --quiet --output " + path("mesh.msh"));
   EXPECT_EQ(run.status, 1) << run.output;
   std::vector<std::string> lines;
   std::istringstream text(run.output);
@@ -571,9 +573,10 @@ TEST_F(CliTest, AFailureAfterRetriesListsEachAttemptOnOneLine) {
   // retried finer, and the settings name each surface's.
   const std::string flat =
       write_obj("flat.obj", testing::graph_patch([](double, double) { return 0.2; }, {0.3, 0.7}, {0.3, 0.7}, 4));
-  const CliRun two = run_cli("--box 0,0,0,1,1,1 --surface " + surface + ":patch --surface " + flat +
-                             ":flat --resolution 0.1 --max-sweeps 1 --fallback-sweeps 0 --finer-retries 1 --quiet " +
-                             "--output " + path("mesh.msh"));
+  const CliRun two =
+      run_cli("--box 0,0,0,1,1,1 --surface " + surface + ":patch --surface " + flat +
+              ":flat --resolution 0.1 --max-sweeps 1 --fallback-sweeps 0 --finer-retries 1 --improve smooth " +
+              "--quiet --output " + path("mesh.msh"));
   EXPECT_EQ(two.status, 1) << two.output;
   for (const char* line : {"\n  attempt 1 (l_r = 0.1, side positive): ",
                            "\n  attempt 2 (l_r = 0.1, side patch negative-only, flat positive): ",

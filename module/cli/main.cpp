@@ -115,7 +115,8 @@ Options:
                            4-4 and larger rings, and edge flips inside the interface where S allows
                            them, also of interface triangles wider than 120 degrees under a tet
                            outside the --improve-angles floors); tets made by a flip leave the
-                           bisection hierarchy. smooth: the node
+                           bisection hierarchy. Tets SUS leaves inverted are flipped around the same
+                           way and SUS runs again, before S_M tries the other side. smooth: the node
                            optimisation alone. none: SUS's mesh as it is
   --improve-threshold Q    the equilateral mean ratio below which a tet is improved (default 0.40;
                            higher costs more time)
@@ -133,7 +134,8 @@ Options:
                            improvement; min_dihedral_deg; seconds per stage and total; improvement:
                            passes, tets below the threshold and smallest quality before and after,
                            shape_passes, tets_outside_floors_before / after,
-                           rounds, operations by kind, tets removed and created, remeshed_tets)
+                           rounds, operations by kind, tets removed and created, remeshed_tets;
+                           smoothing.untangling_flips when they ran: rounds, operations by kind)
   --histograms FILE.csv    quality histograms before and after smoothing, both measures (plot them
                            with scripts/plot_quality.py)
   --output FILE            the mesh with the 3D group `domain`, the 2D groups xmin, xmax, ymin, ymax,

@@ -63,7 +63,21 @@ void write_surface(JsonWriter& json, const SurfaceInsertion& inserted, Stage las
   json.end_object();
 }
 
-void write_smoothing(JsonWriter& json, const SmoothingStats& s, double seconds) {
+// "operations" by kind, and the tets removed and created.
+void write_flip_operations(JsonWriter& json, const FlipStats& flips) {
+  json.key("operations").begin_object();
+  json.key("flips_2_3").value(flips.flips_2_3).key("flips_3_2").value(flips.flips_3_2);
+  json.key("flips_4_4").value(flips.flips_4_4).key("edge_removals").value(flips.edge_removals);
+  json.key("surface_edge_flips").value(flips.surface_edge_flips);
+  json.key("cap_flips").value(flips.cap_flips);
+  json.key("crease_splits").value(flips.crease_splits);
+  json.key("crease_moves").value(flips.crease_moves);
+  json.end_object();
+  json.key("tets_removed").value(flips.tets_removed).key("tets_created").value(flips.tets_created);
+}
+
+void write_smoothing(JsonWriter& json, const InsertionResult& result) {
+  const SmoothingStats& s = result.smoothing;
   json.key("smoothing").begin_object();
   json.key("inner_nodes").value(s.inner_nodes).key("box_nodes").value(s.box_nodes);
   json.key("surface_nodes").value(s.surface_nodes).key("rim_nodes").value(s.rim_nodes);
@@ -81,7 +95,12 @@ void write_smoothing(JsonWriter& json, const SmoothingStats& s, double seconds) 
     json.key("seconds").value(sweep.seconds).end_object();
   }
   json.end_array();
-  json.key("seconds").value(seconds).end_object();
+  if (result.untangling_flip_rounds > 0) {
+    json.key("untangling_flips").begin_object().key("rounds").value(result.untangling_flip_rounds);
+    write_flip_operations(json, result.untangling_flips);
+    json.end_object();
+  }
+  json.key("seconds").value(result.smoothing_seconds).end_object();
 }
 
 void write_improvement(JsonWriter& json, const ImprovementStats& s, double seconds) {
@@ -102,15 +121,7 @@ void write_improvement(JsonWriter& json, const ImprovementStats& s, double secon
   json.key("tets_outside_floors_before").value(s.tets_outside_floors_before);
   json.key("tets_outside_floors_after").value(s.tets_outside_floors_after);
   json.key("rounds").value(s.rounds);
-  json.key("operations").begin_object();
-  json.key("flips_2_3").value(s.flips.flips_2_3).key("flips_3_2").value(s.flips.flips_3_2);
-  json.key("flips_4_4").value(s.flips.flips_4_4).key("edge_removals").value(s.flips.edge_removals);
-  json.key("surface_edge_flips").value(s.flips.surface_edge_flips);
-  json.key("cap_flips").value(s.flips.cap_flips);
-  json.key("crease_splits").value(s.flips.crease_splits);
-  json.key("crease_moves").value(s.flips.crease_moves);
-  json.end_object();
-  json.key("tets_removed").value(s.flips.tets_removed).key("tets_created").value(s.flips.tets_created);
+  write_flip_operations(json, s.flips);
   json.key("remeshed_tets").value(s.remeshed_tets);
   json.key("seconds").value(seconds).end_object();
 }
@@ -161,7 +172,7 @@ void write_insertion_report(JsonWriter& json, const InsertionResult& result, Sta
     json.key("drag").begin_object().key("rings").value(result.drag.rings).key("nodes").value(result.drag.nodes);
     json.key("inverted_tets").value(result.drag.inverted_tets).end_object();
   }
-  if (smoothed) write_smoothing(json, result.smoothing, result.smoothing_seconds);
+  if (smoothed) write_smoothing(json, result);
   if (smoothed && result.improvement) write_improvement(json, *result.improvement, result.improvement_seconds);
   json.end_object();
 }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -158,6 +159,26 @@ class Flipper {
     return stats_;
   }
 
+  // Untangling: each inverted tet, worst first, takes its best flip or edge removal (improve) that
+  // leaves no more tets inverted than it removes, in passes while a pass makes any. S_M edges are among
+  // those removed, so an S_M triangle squeezed flat against a crease edge, which no node move gives
+  // volume, may be flipped away.
+  FlipStats untangle() {
+    untangling_ = true;
+    index_incident();  // for unsafe_while_tangled
+    for (int pass = 1; pass <= options_.max_flip_passes; ++pass) {
+      std::vector<TetId> inverted;
+      for (TetId t = 0; t < mesh_.num_tets(); ++t)
+        if (!dead(t) && !(quality(mesh_.oriented_tet(t)) > 0.0)) inverted.push_back(t);
+      const FlipStats before = stats_;
+      for (const auto& [quality, t] : worst_of(inverted)) improve(t);
+      if (stats_.operations() == before.operations()) break;
+    }
+    incident_.clear();
+    compact();
+    return stats_;
+  }
+
  private:
   // The cube of the equilateral mean ratio of a positively ordered tet, negative when inverted: flips only
   // compare qualities, and the cube orders them the same way without a cube root.
@@ -210,7 +231,8 @@ class Flipper {
     std::optional<Retriangulation> best;
     auto consider = [&](std::optional<Retriangulation> candidate) {
       if (candidate && candidate->worst_created > candidate->worst_removed &&
-          (!best || candidate->worst_created > best->worst_created))
+          (!best || candidate->worst_created > best->worst_created) &&
+          (!untangling_ || (inverts_no_more(*candidate) && !unsafe_while_tangled(*candidate))))
         best = std::move(candidate);
     };
     const Tet& v = mesh_.tets[t];
@@ -218,6 +240,55 @@ class Flipper {
       for (int j = i + 1; j < 4; ++j) consider(edge_removal(t, v[i], v[j]));
     for (int f = 0; f < 4; ++f) consider(flip_2_3(t, f));
     if (best) apply(*best);
+  }
+
+  // Whether r leaves at most as many tets inverted as it removes.
+  bool inverts_no_more(const Retriangulation& r) const {
+    auto inverted = [&](const Tet& tet) { return !(quality(tet) > 0.0); };
+    const auto removed = std::ranges::count_if(r.removed, [&](TetId t) { return inverted(mesh_.oriented_tet(t)); });
+    return std::ranges::count_if(r.created, inverted) <= removed;
+  }
+
+  // Whether r would make an edge or a face that a tet outside the cavity already has (needs incident_),
+  // or a chord: an edge between two nodes of one S_M that is not an edge of S_M. In a valid mesh the new
+  // tets' orientation rules out the first; in a tangled one the cavity may overlap other tets, and such a
+  // flip would break the mesh's manifold structure. The tets around a chord all lie on one side of S_M,
+  // so some stay inverted for good (stages/surface_approximation.cpp, which heals them away).
+  bool unsafe_while_tangled(const Retriangulation& r) const {
+    // The new S_M edge of an edge flip inside S_M: the two new interface faces' common nodes.
+    std::vector<VertexId> new_surface_edge;
+    if (r.tagged_faces.size() == 2)
+      std::ranges::set_intersection(r.tagged_faces[0].first, r.tagged_faces[1].first,
+                                    std::back_inserter(new_surface_edge));
+    auto chord = [&](VertexId u, VertexId v) {
+      return surface_of_[u] >= 0 && surface_of_[u] == surface_of_[v] &&
+             !(new_surface_edge.size() == 2 && std::ranges::find(new_surface_edge, u) != new_surface_edge.end() &&
+               std::ranges::find(new_surface_edge, v) != new_surface_edge.end());
+    };
+    auto held_by_removed = [&](std::span<const VertexId> simplex) {
+      return std::ranges::any_of(r.removed, [&](TetId t) {
+        return std::ranges::all_of(
+            simplex, [&](VertexId v) { return std::ranges::find(mesh_.tets[t], v) != mesh_.tets[t].end(); });
+      });
+    };
+    auto held_outside = [&](std::span<const VertexId> simplex) {
+      return std::ranges::any_of(star_of(simplex[0]), [&](TetId t) {
+        return std::ranges::find(r.removed, t) == r.removed.end() && std::ranges::all_of(simplex, [&](VertexId v) {
+                 return std::ranges::find(mesh_.tets[t], v) != mesh_.tets[t].end();
+               });
+      });
+    };
+    for (const Tet& tet : r.created)
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) {
+          const std::array<VertexId, 2> edge{tet[i], tet[j]};
+          if (!held_by_removed(edge) && (chord(tet[i], tet[j]) || held_outside(edge))) return true;
+          for (int k = j + 1; k < 4; ++k) {
+            const std::array<VertexId, 3> face{tet[i], tet[j], tet[k]};
+            if (!held_by_removed(face) && held_outside(face)) return true;
+          }
+        }
+    return false;
   }
 
   // An S_M cap (a triangle (a, b, c) whose angle at c is wider than options_.cap_angle) gives the tets standing
@@ -965,6 +1036,7 @@ class Flipper {
   std::vector<std::map<std::array<int, 3>, int>> triangle_of_;
   std::vector<TetId> incident_;  // while mending creases or caps: a tet holding each vertex
   double mend_floor_ = 0.0;      // while mending creases: see acceptable()
+  bool untangling_ = false;      // flipping around inverted tets (untangle)
   std::vector<TetId> free_;      // slots of removed tets not yet reused
   std::vector<TetId> created_;   // the slots filled by this pass's flips
   FlipStats stats_;
@@ -999,6 +1071,11 @@ std::string describe(const FlipStats& flips) {
 FlipStats flip_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
                           std::span<TetRegion* const> regions, const ImprovementOptions& options) {
   return Flipper(mesh, surfaces, regions, options).run();
+}
+
+FlipStats flip_inverted_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
+                             std::span<TetRegion* const> regions, const ImprovementOptions& options) {
+  return Flipper(mesh, surfaces, regions, options).untangle();
 }
 
 FlipStats conform_to_creases(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,

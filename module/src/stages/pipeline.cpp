@@ -386,14 +386,64 @@ void untangle_and_smooth(InsertionResult& result, std::span<SurfaceProjection* c
   report_smoothing(options, result.smoothing);
 }
 
+// Each surface's V_M, which the flips carry over to the tets they make.
+std::vector<TetRegion*> volumetric_regions(InsertionResult& result) {
+  std::vector<TetRegion*> regions;
+  for (SurfaceInsertion& inserted : result.surfaces) regions.push_back(&inserted.volumetric);
+  return regions;
+}
+
+// SUS's statistics over a run that continued the one before it from where that one ended: the node
+// counts and the end state are the later run's, the sweeps are counted from the first.
+void continue_smoothing_stats(SmoothingStats& stats, SmoothingStats later) {
+  const int offset = static_cast<int>(stats.sweeps.size());
+  if (later.inverted_before == 0) later.untangling_sweeps = offset;
+  else if (later.untangled()) later.untangling_sweeps += offset;
+  later.fallback_sweep = stats.fallback_sweep > 0   ? stats.fallback_sweep
+                         : later.fallback_sweep > 0 ? later.fallback_sweep + offset
+                                                    : 0;
+  later.inverted_before = stats.inverted_before;
+  later.sweeps.insert(later.sweeps.begin(), stats.sweeps.begin(), stats.sweeps.end());
+  stats = std::move(later);
+}
+
+// Where SUS leaves tets inverted, their connectivity can lock them: a tet standing on an S_M triangle that
+// untangling squeezed flat against a crease edge of S gains volume from no node move (doc/robustness.md,
+// "Box margins and resolutions off the benchmark's grid"). Flips around the inverted tets, S_M's edges
+// included, change that connectivity, and SUS runs again from there; at most max_untangling_flip_rounds
+// times, and only with --improve topology, since flips end the bisection hierarchy.
+void untangle_by_flips(InsertionResult& result, std::span<SurfaceProjection* const> projections,
+                       const InsertionOptions& options) {
+  constexpr int max_untangling_flip_rounds = 2;
+  for (int round = 0; round < max_untangling_flip_rounds && !result.smoothing.untangled(); ++round) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::vector<TetRegion*> regions = volumetric_regions(result);
+    const FlipStats flips = flip_inverted_tets(result.mesh, projections, regions, options.improvement);
+    result.untangling_flips += flips;
+    ++result.untangling_flip_rounds;
+    const double flip_seconds = seconds_since(start);
+    report(options, "untangling flips: ", describe(flips), "; tets inverted ", result.smoothing.inverted_after, " -> ",
+           count_inverted(result.mesh));
+    if (flips.operations() == 0) return;
+    SmoothingStats earlier = std::move(result.smoothing);
+    const double earlier_seconds = result.smoothing_seconds + flip_seconds;
+    // The meccano target has stalled once already: untangling aims at the equilateral tet after one sweep.
+    InsertionOptions again = options;
+    again.smoothing.fallback_sweeps = std::min(options.smoothing.fallback_sweeps, 1);
+    untangle_and_smooth(result, projections, again);
+    continue_smoothing_stats(earlier, std::move(result.smoothing));
+    result.smoothing = std::move(earlier);
+    result.smoothing_seconds += earlier_seconds;
+  }
+}
+
 void lift_worst_tets(InsertionResult& result, std::span<SurfaceProjection* const> projections,
                      const InsertionOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   ImprovementOptions improvement = options.improvement;
   improvement.topology = options.improve == Improvement::topology;
   if (options.progress) improvement.progress = options.progress;
-  std::vector<TetRegion*> regions;
-  for (SurfaceInsertion& inserted : result.surfaces) regions.push_back(&inserted.volumetric);
+  const std::vector<TetRegion*> regions = volumetric_regions(result);
   const ImprovementStats& improved =
       result.improvement.emplace(improve_worst_tets(result.mesh, projections, improvement, options.smoothing, regions));
   result.improvement_seconds = seconds_since(started);
@@ -406,6 +456,8 @@ bool untangle_smooth_and_improve(InsertionResult& result, const InsertionOptions
   for (SurfaceInsertion& inserted : result.surfaces)
     for (SurfaceProjection& projection : inserted.projections) projections.push_back(&projection);
   untangle_and_smooth(result, projections, options);
+  if (!result.smoothing.untangled() && options.improve == Improvement::topology)
+    untangle_by_flips(result, projections, options);
   if (!result.smoothing.untangled()) return false;
   if (!result.smoothing.sweeps.empty()) check_stage(result.mesh, "smoothing");  // else it moved nothing
   if (options.improve != Improvement::none) {
@@ -463,8 +515,11 @@ class ThreadCount {
 };
 
 std::string tets_still_inverted(const InsertionResult& result) {
+  const int rounds = result.untangling_flip_rounds;
   return std::to_string(result.smoothing.inverted_after) + " tets are still inverted after " +
-         std::to_string(result.smoothing.sweeps.size()) + " sweeps";
+         std::to_string(result.smoothing.sweeps.size()) + " sweeps" +
+         (rounds > 0 ? " and " + std::to_string(rounds) + (rounds == 1 ? " round" : " rounds") + " of untangling flips"
+                     : "");
 }
 
 std::string untangling_failure(const InsertionResult& result) {

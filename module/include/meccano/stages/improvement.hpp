@@ -161,6 +161,16 @@ ImprovementStats improve_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* 
 FlipStats flip_worst_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
                           std::span<TetRegion* const> regions = {}, const ImprovementOptions& options = {});
 
+// Untangling by flips, for the pipeline when SUS leaves tets inverted (with options.topology): each inverted
+// tet, worst first, takes the 2-3 flip or edge removal (S_M's own edges included, as in flip_worst_tets)
+// whose worst new tet is best, if that beats the worst tet it removes and leaves no more tets inverted
+// than it removes; passes repeat while they make any (at most max_flip_passes). Since a tangled mesh's
+// cavities can overlap other tets, a flip that would make an edge or face some other tet has, or a chord
+// (an edge between two nodes of one S_M that is not an S_M edge), is not made. Moves no node; SUS then
+// runs again from the new connectivity.
+FlipStats flip_inverted_tets(TetMesh& mesh, std::span<SurfaceProjection* const> surfaces,
+                             std::span<TetRegion* const> regions = {}, const ImprovementOptions& options = {});
+
 // What improve_worst_tets does first with options.topology: every S_M edge that a crease line of S crosses
 // between its nodes (surface/creases.hpp, straddling_crossings) is mended, by moving one of its nodes onto the
 // crossing or by splitting it there, whichever leaves the best worst tet, unless a tet would be inverted

@@ -13,9 +13,11 @@
 //             the cubes at every l_r, and the other side may reach it), then at a finer l_r. The last
 //             attempt allowed skips this check: smoothing then gets its chance, as before the check;
 //          4. simultaneous untangling and smoothing of the whole mesh or of a band around the surfaces
-//             (stages/smoothing.hpp). If tets stay inverted, the insertion is run again with the S_M of the
-//             surfaces next to them on the other side of S (when the side rule allows it); a mesh that
-//             stays tangled is an error, never a result.
+//             (stages/smoothing.hpp). If tets stay inverted, flips around them change the connectivity
+//             that may lock them and SUS runs again from there (with options.improve topology); if tets
+//             still stay inverted, the insertion is run again with the S_M of the surfaces next to them on
+//             the other side of S (when the side rule allows it); a mesh that stays tangled is an error,
+//             never a result.
 //          Then the worst tets are lifted (stages/improvement.hpp) unless options.improve is none; the quality
 //          after smoothing is that of the result, after the improvement.
 //          A surface whose insertion still fails (V_M cannot be grown within reach of S, S_M cannot be
@@ -128,8 +130,11 @@ struct InsertionResult {
   TetMesh mesh;
   std::vector<SurfaceInsertion> surfaces;
   DragStats drag;
-  SmoothingStats smoothing;
-  double smoothing_seconds = 0.0;
+  SmoothingStats smoothing;        // over every SUS run: after untangling flips, SUS runs again from there
+  double smoothing_seconds = 0.0;  // SUS and the untangling flips
+  // Flips around the tets SUS left inverted (options.improve topology), and the rounds of them tried.
+  FlipStats untangling_flips;
+  int untangling_flip_rounds = 0;
   QualitySummary quality_before_smoothing;      // right after projection and the drag (tets may be inverted)
   std::optional<ImprovementStats> improvement;  // when the improvement ran
   double improvement_seconds = 0.0;

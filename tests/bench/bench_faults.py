@@ -326,6 +326,9 @@ def module_row(case, divisor, module):
     seconds, surface, smoothing = r["seconds"], r["surfaces"][0], r.get("smoothing", {})
     estimate = r.get("estimated_tets")
     side = "yes" if r.get("side_retry") else "no"
+    flips = sum(smoothing.get("untangling_flips", {}).get("operations", {}).values())
+    if flips:
+        side += f", {flips} untangling flips"
     fallback = smoothing.get("fallback_sweep", 0)
     return [case, resolution_label(divisor, module), surface["volumetric"].get("level", DASH), thousands(module["tets"]),
             f"{estimate / module['tets']:.2f}" if estimate else DASH,
@@ -541,7 +544,8 @@ l_r = E/30, E/50, E/70, E/100.
 
 - *Module*: `meccano-immerse` with all four steps; its report's seconds per stage (volumetric,
   approximation, projection, SUS) and total; "level" is the Kossaczky level V_M was refined to;
-  "retries" the finer retries and whether S_M was tried on the other side; "fallback sweep" the first
+  "retries" the finer retries, whether S_M was tried on the other side, and the flips made around tets
+  SUS left inverted (none unless it did); "fallback sweep" the first
   sweep towards the equilateral fallback (– none); peak RSS from `/usr/bin/time -v`.
 - *Quality*: η is the mean ratio against each tet's meccano counterpart (the paper's measure) and
   against the equilateral tet; normal deviation, flipped faces, Hausdorff and node distance come from

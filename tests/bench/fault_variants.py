@@ -13,7 +13,8 @@ the 45 % at the other; the largest edge-connected part, skipped unless a disk). 
 is the fault as it is, for other boxes and resolutions (not run by default). Each variant is written as
 OBJ and inserted at l_r = E / divisor in its bounding box grown by margin x E per side (E its largest
 extent; 0.1, bench_faults' box, by default); each result is checked with `meccano-immerse check`. Prints
-one line per run: exit status, seconds, tets, retries (finer l_r, other side) and why.
+one line per run: exit status, seconds, tets, retries (finer l_r, other side), the untangling flips made
+(flips:N) and why.
 """
 import argparse
 import glob
@@ -173,7 +174,9 @@ def main():
                 report = json.load(open(msh + ".json"))
                 finer = report["surfaces"][0]["resolution"] < 0.999 * extent / divisor
                 status = "ok" if check.returncode == 0 else "INVALID"
-                retries = ("finer " if finer else "") + ("side " if report.get("side_retry") else "")
+                flips = report["smoothing"].get("untangling_flips", {}).get("operations", {})
+                retries = (("finer " if finer else "") + ("side " if report.get("side_retry") else "") +
+                           (f"flips:{sum(flips.values())} " if sum(flips.values()) else ""))
                 print(f"{label} {status:4s} {seconds:7.1f} s {report['tets']:>9d} tets "
                       f"{retries or '-'} {report.get('side_retry') or ''}"[:400], flush=True)
                 os.remove(msh)

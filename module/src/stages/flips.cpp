@@ -1034,7 +1034,7 @@ class Flipper {
   std::map<std::pair<int, VertexId>, int> shared_index_;  // (projection, shared vertex) -> its index there
   // Per surface, S_M's triangles by their sorted node indices (triangle_index).
   std::vector<std::map<std::array<int, 3>, int>> triangle_of_;
-  std::vector<TetId> incident_;  // while mending creases or caps: a tet holding each vertex
+  std::vector<TetId> incident_;  // while mending creases or caps, or untangling: a tet holding each vertex
   double mend_floor_ = 0.0;      // while mending creases: see acceptable()
   bool untangling_ = false;      // flipping around inverted tets (untangle)
   std::vector<TetId> free_;      // slots of removed tets not yet reused

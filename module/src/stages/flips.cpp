@@ -265,17 +265,16 @@ class Flipper {
              !(new_surface_edge.size() == 2 && std::ranges::find(new_surface_edge, u) != new_surface_edge.end() &&
                std::ranges::find(new_surface_edge, v) != new_surface_edge.end());
     };
+    auto holds = [&](TetId t, std::span<const VertexId> simplex) {
+      return std::ranges::all_of(
+          simplex, [&](VertexId v) { return std::ranges::find(mesh_.tets[t], v) != mesh_.tets[t].end(); });
+    };
     auto held_by_removed = [&](std::span<const VertexId> simplex) {
-      return std::ranges::any_of(r.removed, [&](TetId t) {
-        return std::ranges::all_of(
-            simplex, [&](VertexId v) { return std::ranges::find(mesh_.tets[t], v) != mesh_.tets[t].end(); });
-      });
+      return std::ranges::any_of(r.removed, [&](TetId t) { return holds(t, simplex); });
     };
     auto held_outside = [&](std::span<const VertexId> simplex) {
       return std::ranges::any_of(star_of(simplex[0]), [&](TetId t) {
-        return std::ranges::find(r.removed, t) == r.removed.end() && std::ranges::all_of(simplex, [&](VertexId v) {
-                 return std::ranges::find(mesh_.tets[t], v) != mesh_.tets[t].end();
-               });
+        return std::ranges::find(r.removed, t) == r.removed.end() && holds(t, simplex);
       });
     };
     for (const Tet& tet : r.created)

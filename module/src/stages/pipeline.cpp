@@ -393,18 +393,18 @@ std::vector<TetRegion*> volumetric_regions(InsertionResult& result) {
   return regions;
 }
 
-// SUS's statistics over a run that continued the one before it from where that one ended: the node
-// counts and the end state are the later run's, the sweeps are counted from the first.
-void continue_smoothing_stats(SmoothingStats& stats, SmoothingStats later) {
-  const int offset = static_cast<int>(stats.sweeps.size());
+// SUS's statistics over `earlier` and a run that continued it from where it ended: the node counts and
+// the end state are the later run's, the sweeps are counted from the first.
+SmoothingStats continued(const SmoothingStats& earlier, SmoothingStats later) {
+  const int offset = static_cast<int>(earlier.sweeps.size());
   if (later.inverted_before == 0) later.untangling_sweeps = offset;
   else if (later.untangled()) later.untangling_sweeps += offset;
-  later.fallback_sweep = stats.fallback_sweep > 0   ? stats.fallback_sweep
+  later.fallback_sweep = earlier.fallback_sweep > 0 ? earlier.fallback_sweep
                          : later.fallback_sweep > 0 ? later.fallback_sweep + offset
                                                     : 0;
-  later.inverted_before = stats.inverted_before;
-  later.sweeps.insert(later.sweeps.begin(), stats.sweeps.begin(), stats.sweeps.end());
-  stats = std::move(later);
+  later.inverted_before = earlier.inverted_before;
+  later.sweeps.insert(later.sweeps.begin(), earlier.sweeps.begin(), earlier.sweeps.end());
+  return later;
 }
 
 // Where SUS leaves tets inverted, their connectivity can lock them: a tet standing on an S_M triangle that
@@ -431,8 +431,7 @@ void untangle_by_flips(InsertionResult& result, std::span<SurfaceProjection* con
     InsertionOptions again = options;
     again.smoothing.fallback_sweeps = std::min(options.smoothing.fallback_sweeps, 1);
     untangle_and_smooth(result, projections, again);
-    continue_smoothing_stats(earlier, std::move(result.smoothing));
-    result.smoothing = std::move(earlier);
+    result.smoothing = continued(earlier, std::move(result.smoothing));
     result.smoothing_seconds += earlier_seconds;
   }
 }
